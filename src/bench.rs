@@ -1,0 +1,149 @@
+//! `sphrepro bench`: throughput (particle-steps per second) and peak memory per particle
+//! of the Taylor-Green vortex for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, over resolutions
+//! and thread counts. Each configuration runs in its own process (`bench-case`), so its
+//! peak resident memory is its own.
+
+use crate::scenes::taylor_green;
+use serde::{Deserialize, Serialize};
+use std::time::Instant;
+
+/// One measured configuration.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct BenchResult {
+    /// `edac`, `ctvf+sun`, `ctvf+ipst`.
+    pub variant: String,
+    /// Particles per side.
+    pub nx: usize,
+    /// Rayon threads.
+    pub threads: usize,
+    /// Particle count.
+    pub particles: usize,
+    /// Timed steps (after warm-up).
+    pub steps: u64,
+    /// Seconds of the timed steps.
+    pub seconds: f64,
+    /// particles x steps / seconds.
+    pub particle_steps_per_second: f64,
+    /// Peak resident memory of the process (bytes).
+    pub peak_rss_bytes: u64,
+    /// (peak resident memory - resident memory before the scene was built) / particles.
+    pub bytes_per_particle: f64,
+    /// Mean IPST iterations per step (0 without IPST).
+    pub ipst_iterations_mean: f64,
+}
+
+/// The variants benchmarked: (name, scheme, pst).
+pub const VARIANTS: &[(&str, &str, &str)] = &[
+    ("edac", "edac", "none"),
+    ("ctvf+sun", "ctvf", "sun"),
+    ("ctvf+ipst", "ctvf", "ipst"),
+];
+
+fn status_kb(field: &str) -> u64 {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            s.lines()
+                .find(|l| l.starts_with(field))
+                .and_then(|l| l.split_whitespace().nth(1))
+                .and_then(|v| v.parse().ok())
+        })
+        .unwrap_or(0)
+}
+
+/// Runs one configuration in this process: `warmup` untimed steps, then `steps` timed
+/// ones. A perturbed lattice (5 % of dx) makes IPST iterate as it does in a developed flow.
+pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<BenchResult, String> {
+    let (_, scheme, pst) = VARIANTS
+        .iter()
+        .find(|v| v.0 == variant)
+        .ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
+    let rss0 = status_kb("VmRSS:") * 1024;
+    let p = taylor_green::params_from(&[
+        &format!("nx={nx}"),
+        &format!("scheme={scheme}"),
+        &format!("pst={pst}"),
+        "re=100",
+        "perturb=0.05",
+    ])?;
+    let mut sim = taylor_green::simulation(&p)?;
+    for _ in 0..warmup {
+        sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+    }
+    let t0 = Instant::now();
+    let mut ipst = 0usize;
+    for _ in 0..steps {
+        sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+        ipst += sim.last_ipst_iterations();
+    }
+    let seconds = t0.elapsed().as_secs_f64();
+    let n = sim.fluid().len();
+    let hwm = status_kb("VmHWM:") * 1024;
+    Ok(BenchResult {
+        variant: variant.into(),
+        nx,
+        threads: rayon::current_num_threads(),
+        particles: n,
+        steps,
+        seconds,
+        particle_steps_per_second: n as f64 * steps as f64 / seconds,
+        peak_rss_bytes: hwm,
+        bytes_per_particle: hwm.saturating_sub(rss0) as f64 / n as f64,
+        ipst_iterations_mean: ipst as f64 / steps as f64,
+    })
+}
+
+/// Steps to time for `n` particles: about 4 million particle-steps, at least 20 steps.
+pub fn default_steps(n: usize) -> u64 {
+    ((4.0e6 / n as f64) as u64).max(20)
+}
+
+/// The benchmark table as Markdown, with the throughput of each variant relative to
+/// `edac` on the same size and threads, and the two-thread speed-up.
+pub fn table(results: &[BenchResult]) -> String {
+    let mut s = String::from(
+        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for r in results {
+        let edac = results
+            .iter()
+            .find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
+        let one = results
+            .iter()
+            .find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
+        let cost = edac
+            .map(|e| {
+                format!(
+                    "{:.2}",
+                    e.particle_steps_per_second / r.particle_steps_per_second
+                )
+            })
+            .unwrap_or_default();
+        let speedup = if r.threads > 1 {
+            one.map(|o| {
+                format!(
+                    "{:.2}",
+                    r.particle_steps_per_second / o.particle_steps_per_second
+                )
+            })
+            .unwrap_or_default()
+        } else {
+            String::new()
+        };
+        s.push_str(&format!(
+            "| {} | {} | {} | {} | {} | {:.3} | {:.0} | {:.0} | {} | {} | {:.2} |\n",
+            r.variant,
+            r.nx,
+            r.particles,
+            r.threads,
+            r.steps,
+            r.particle_steps_per_second / 1e6,
+            1e9 / r.particle_steps_per_second * r.threads as f64 / r.threads as f64,
+            r.bytes_per_particle,
+            cost,
+            speedup,
+            r.ipst_iterations_mean
+        ));
+    }
+    s
+}

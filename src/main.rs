@@ -1,0 +1,261 @@
+//! The `sphrepro` command line. Thin: every command calls into the library.
+
+use clap::{Parser, Subcommand};
+use sphrepro::bench;
+use sphrepro::scenes::{self, harness};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Reproduce SPH papers with one command.
+#[derive(Parser)]
+#[command(name = "sphrepro", version, about)]
+struct Cli {
+    /// Rayon threads (default: all cores, or RAYON_NUM_THREADS).
+    #[arg(long, global = true)]
+    threads: Option<usize>,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// List the scenes and their parameters.
+    List,
+    /// Run one simulation, no cache: writes DIR/summary.json, timeseries.csv and snapshots.
+    Simulate {
+        /// Scene name (see `list`).
+        scene: String,
+        /// Parameter, as key=value (repeatable).
+        #[arg(long = "set", value_name = "KEY=VALUE")]
+        sets: Vec<String>,
+        /// Output folder.
+        #[arg(long)]
+        out: PathBuf,
+        /// No progress bar or plan on stderr.
+        #[arg(long)]
+        quiet: bool,
+        /// Overwrite a finished run in the output folder.
+        #[arg(long)]
+        force: bool,
+        /// Write `time tf steps` to this file about twice a second.
+        #[arg(long, hide = true)]
+        progress_file: Option<PathBuf>,
+    },
+    /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
+    Bench {
+        /// Resolutions (particles per side).
+        #[arg(long, value_delimiter = ',', default_values_t = vec![50usize, 100, 200, 400])]
+        nx: Vec<usize>,
+        /// Thread counts.
+        #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2])]
+        bench_threads: Vec<usize>,
+        /// Variants (edac, ctvf+sun, ctvf+ipst).
+        #[arg(long, value_delimiter = ',')]
+        variants: Option<Vec<String>>,
+        /// Timed steps per case (default: about 4 million particle-steps).
+        #[arg(long)]
+        steps: Option<u64>,
+        /// Where to write the results as JSON.
+        #[arg(long, default_value = "output/bench.json")]
+        json: PathBuf,
+    },
+    /// One benchmark configuration in this process (used by `bench`).
+    #[command(hide = true)]
+    BenchCase {
+        #[arg(long)]
+        variant: String,
+        #[arg(long)]
+        nx: usize,
+        #[arg(long)]
+        steps: u64,
+    },
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    if let Some(n) = cli.threads {
+        if let Err(e) = rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+        {
+            eprintln!("error: cannot start {n} threads: {e}");
+            return ExitCode::from(2);
+        }
+    }
+    let _ = ctrlc::set_handler(|| {
+        if harness::INTERRUPTED.swap(true, std::sync::atomic::Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+    match cli.command {
+        Command::List => {
+            for s in scenes::SCENES {
+                println!("{} ({}D): {}", s.name, s.dim, s.about);
+                for p in (s.params)() {
+                    println!(
+                        "    {:<16} {:<28} default {:<14} {}",
+                        p.name,
+                        p.kind_name(),
+                        p.default.to_string(),
+                        p.help
+                    );
+                }
+                println!("    metrics: {}", s.metrics.join(", "));
+            }
+            ExitCode::SUCCESS
+        }
+        Command::Simulate {
+            scene,
+            sets,
+            out,
+            quiet,
+            force,
+            progress_file,
+        } => {
+            let entry = match scenes::find(&scene) {
+                Ok(e) => e,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let params = match entry.params_from_sets(&sets) {
+                Ok(p) => p,
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    return ExitCode::from(2);
+                }
+            };
+            let opts = harness::RunOptions {
+                quiet,
+                force,
+                progress_file,
+            };
+            match harness::run(entry, &params, &out, &opts) {
+                Ok(s) => match s.status {
+                    sphrepro::solver::output::summary::Status::Completed => {
+                        if !quiet {
+                            eprintln!(
+                                "completed: {} steps, {:.2} s, {:.3e} particle-steps/s",
+                                s.steps, s.wall_seconds, s.particle_steps_per_second
+                            );
+                            for (k, v) in &s.metrics {
+                                eprintln!("  {k} = {v:.6e}");
+                            }
+                        }
+                        ExitCode::SUCCESS
+                    }
+                    _ => {
+                        eprintln!(
+                            "diverged at step {} (t = {}): {}",
+                            s.step.unwrap_or(s.steps),
+                            s.final_time,
+                            s.reason.as_deref().unwrap_or("")
+                        );
+                        ExitCode::from(3)
+                    }
+                },
+                Err(harness::RunError::Input(e)) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(2)
+                }
+                Err(harness::RunError::Failed(e)) => {
+                    eprintln!("failed: {e}");
+                    ExitCode::from(1)
+                }
+            }
+        }
+        Command::Bench {
+            nx,
+            bench_threads,
+            variants,
+            steps,
+            json,
+        } => run_bench(nx, bench_threads, variants, steps, json),
+        Command::BenchCase { variant, nx, steps } => {
+            match bench::run_case(&variant, nx, steps, 5) {
+                Ok(r) => {
+                    println!("{}", serde_json::to_string(&r).expect("serialises"));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(1)
+                }
+            }
+        }
+    }
+}
+
+fn run_bench(
+    nx: Vec<usize>,
+    threads: Vec<usize>,
+    variants: Option<Vec<String>>,
+    steps: Option<u64>,
+    json: PathBuf,
+) -> ExitCode {
+    let variants: Vec<String> =
+        variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
+    let exe = std::env::current_exe().expect("own executable");
+    let mut results = Vec::new();
+    for &n in &nx {
+        for v in &variants {
+            for &t in &threads {
+                let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
+                eprint!("bench {v} nx={n} threads={t} steps={k} ... ");
+                let out = std::process::Command::new(&exe)
+                    .args([
+                        "--threads",
+                        &t.to_string(),
+                        "bench-case",
+                        "--variant",
+                        v,
+                        "--nx",
+                        &n.to_string(),
+                        "--steps",
+                        &k.to_string(),
+                    ])
+                    .output();
+                match out {
+                    Ok(o) if o.status.success() => {
+                        match serde_json::from_slice::<bench::BenchResult>(&o.stdout) {
+                            Ok(r) => {
+                                eprintln!(
+                                    "{:.3} M particle-steps/s",
+                                    r.particle_steps_per_second / 1e6
+                                );
+                                results.push(r);
+                            }
+                            Err(e) => {
+                                eprintln!("unreadable result: {e}");
+                                return ExitCode::from(1);
+                            }
+                        }
+                    }
+                    Ok(o) => {
+                        eprintln!("failed: {}", String::from_utf8_lossy(&o.stderr));
+                        return ExitCode::from(1);
+                    }
+                    Err(e) => {
+                        eprintln!("cannot run {}: {e}", exe.display());
+                        return ExitCode::from(1);
+                    }
+                }
+            }
+        }
+    }
+    println!("{}", bench::table(&results));
+    if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            eprintln!("error: {}: {e}", dir.display());
+            return ExitCode::from(1);
+        }
+    }
+    let text = serde_json::to_string_pretty(&results).expect("serialises");
+    if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {
+        eprintln!("error: {}: {e}", json.display());
+        return ExitCode::from(1);
+    }
+    eprintln!("wrote {}", json.display());
+    ExitCode::SUCCESS
+}

@@ -1,0 +1,106 @@
+//! Scenes: one module per benchmark geometry and initial condition. A scene declares its
+//! parameters ([`params::Spec`]), builds a simulation from them and computes its metrics;
+//! the [`harness`] runs any scene and writes its output. The automation half sees only
+//! [`SCENES`].
+
+pub mod harness;
+pub mod params;
+pub mod taylor_green;
+
+use crate::solver::simulation::Divergence;
+use params::{Params, Spec};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// A scene built from parameters and ready to run: the dimension-free face of a
+/// `Simulation<D>` plus the scene's own bookkeeping.
+pub trait SceneRun {
+    /// Particles in all bodies.
+    fn particles(&self) -> usize;
+    /// Simulated time.
+    fn time(&self) -> f64;
+    /// Steps taken.
+    fn steps(&self) -> u64;
+    /// The plan (bodies, scheme and terms), written at the top of the run log.
+    fn plan(&self) -> String;
+    /// Advances to `t` exactly, calling `on_step(time, steps)` after every step.
+    fn advance_to(&mut self, t: f64, on_step: &mut dyn FnMut(f64, u64)) -> Result<(), Divergence>;
+    /// One time-series row: named values at the current time (the first is `t`).
+    fn sample(&mut self) -> Vec<(&'static str, f64)>;
+    /// Writes the bodies' snapshots for output number `index` into `dir`; returns the file
+    /// names written (relative to `dir`), one per body, with the body name.
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>>;
+    /// The metrics of `summary.json` at the end of a completed run.
+    fn metrics(&self) -> BTreeMap<String, f64>;
+}
+
+/// A registered scene.
+pub struct SceneEntry {
+    /// Name used on the command line and in problem files.
+    pub name: &'static str,
+    /// Spatial dimension.
+    pub dim: usize,
+    /// One line on what it is.
+    pub about: &'static str,
+    /// Declared parameters (every scene has `tf`, `output_dt` and `sample_dt`).
+    pub params: fn() -> Vec<Spec>,
+    /// Builds the scene; errors name the parameter.
+    pub build: fn(&Params) -> Result<Box<dyn SceneRun>, String>,
+    /// Names of the metrics written to `summary.json`.
+    pub metrics: &'static [&'static str],
+}
+
+/// Every scene.
+pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY];
+
+/// Looks a scene up by name.
+pub fn find(name: &str) -> Result<&'static SceneEntry, String> {
+    SCENES.iter().find(|s| s.name == name).ok_or_else(|| {
+        let known: Vec<_> = SCENES.iter().map(|s| s.name).collect();
+        format!("unknown scene `{name}`; known scenes: {}", known.join(", "))
+    })
+}
+
+impl SceneEntry {
+    /// Parameters from `key=value` strings over the defaults.
+    pub fn params_from_sets(&self, sets: &[String]) -> Result<Params, String> {
+        let specs = (self.params)();
+        let mut p = Params::defaults(&specs);
+        for s in sets {
+            let (k, v) = s.split_once('=').ok_or_else(|| {
+                format!(
+                    "scene `{}`: `--set {s}` is not of the form key=value",
+                    self.name
+                )
+            })?;
+            p.set_str(self.name, &specs, k.trim(), v)?;
+        }
+        Ok(p)
+    }
+}
+
+/// The parameters every scene shares, appended to its own.
+pub fn common_params(tf: f64) -> Vec<Spec> {
+    use params::Bound;
+    vec![
+        Spec::float("tf", tf, Bound::Positive, "end time (s)"),
+        Spec::float(
+            "output_dt",
+            0.0,
+            Bound::NonNegative,
+            "interval between ParaView snapshots (s); 0: tf/10",
+        ),
+        Spec::float(
+            "sample_dt",
+            0.0,
+            Bound::NonNegative,
+            "interval between time-series rows (s); 0: tf/100",
+        ),
+        Spec::float(
+            "cfl",
+            0.25,
+            Bound::Positive,
+            "factor of the time-step limits, CTVF eq. (61)",
+        ),
+    ]
+}

@@ -1,0 +1,403 @@
+//! Taylor-Green vortex in a periodic unit square (CTVF paper, sec. 4.1).
+//!
+//! Exact solution, eqs. (63)-(65), with `b = -8 pi^2 / Re`, U = 1 m/s, L = 1 m:
+//! `u = -U e^{bt} cos(2 pi x) sin(2 pi y)`, `v = U e^{bt} sin(2 pi x) cos(2 pi y)`,
+//! `p = -U^2 e^{2bt} (cos(4 pi x) + cos(4 pi y)) / 4`. Quintic spline, h/dx = 1, summation
+//! density, no artificial viscosity, c0 = 10 U, rho0 = 1.
+//!
+//! Metrics in `summary.json`:
+//! - `l1_velocity_final`: eq. (66) as PySPH computes it, mean | |u_i| - |u_exact(x_i)| |
+//!   over mean |u_exact|, at tf;
+//! - `l1_velocity_max`: the largest value of the same over the time series;
+//! - `umax_decay_rel_error`: |max |u| - U e^{b tf}| / (U e^{b tf});
+//! - `p_l1_final`: mean |(p - mean p) - (p_e - mean p_e)| over max |p_e| at tf;
+//! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
+
+use super::params::{Bound, Params, Spec};
+use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::{Kernel, KernelKind};
+use crate::solver::math::Vector;
+use crate::solver::nnps::Domain;
+use crate::solver::output::vtu::{write_vtu, Field};
+use crate::solver::particles::{Fluid, FluidInit};
+use crate::solver::scheme::{Corrections, DensityModel, FluidSettings, Pst, SchemeName};
+use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use rand::{Rng, SeedableRng};
+use std::collections::BTreeMap;
+use std::f64::consts::PI;
+use std::path::Path;
+
+const U: f64 = 1.0;
+const L: f64 = 1.0;
+const RHO0: f64 = 1.0;
+const C0: f64 = 10.0 * U;
+
+/// The registry entry.
+pub const ENTRY: SceneEntry = SceneEntry {
+    name: "taylor_green",
+    dim: 2,
+    about:
+        "Taylor-Green vortex in a periodic unit square, against the exact solution (CTVF sec. 4.1)",
+    params,
+    build,
+    metrics: &[
+        "l1_velocity_final",
+        "l1_velocity_max",
+        "umax_decay_rel_error",
+        "p_l1_final",
+        "kinetic_energy_rel_error",
+    ],
+};
+
+const SWITCH: &[&str] = &["auto", "on", "off"];
+
+fn params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::int("nx", 50, 1, "particles per side"),
+        Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
+        Spec::choice("scheme", SchemeName::NAMES, "ctvf", "fluid scheme"),
+        Spec::choice(
+            "pst",
+            Pst::NAMES,
+            "sun",
+            "particle shifting for ctvf: Sun 2019, IPST or none",
+        ),
+        Spec::choice(
+            "kernel",
+            KernelKind::NAMES,
+            "quintic_spline",
+            "smoothing kernel",
+        ),
+        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
+        Spec::choice(
+            "corrections",
+            &["all", "none"],
+            "all",
+            "the CTVF correction terms, together",
+        ),
+        Spec::choice(
+            "corr_continuity",
+            SWITCH,
+            "auto",
+            "the correction of eq. (25); auto follows `corrections`",
+        ),
+        Spec::choice(
+            "corr_pressure",
+            SWITCH,
+            "auto",
+            "the corrections of eq. (26); auto follows `corrections`",
+        ),
+        Spec::choice(
+            "corr_momentum",
+            SWITCH,
+            "auto",
+            "the -u div(u~ - u) term of eq. (19); auto follows `corrections`",
+        ),
+        Spec::float(
+            "perturb",
+            0.0,
+            Bound::NonNegative,
+            "random initial displacement, as a fraction of dx",
+        ),
+        Spec::int("seed", 1, 0, "seed of the initial perturbation"),
+        Spec::float(
+            "edac_alpha",
+            0.5,
+            Bound::Positive,
+            "alpha of nu_edac, eq. (24)",
+        ),
+        Spec::float(
+            "ipst_tol",
+            0.02,
+            Bound::Positive,
+            "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
+        ),
+        Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
+    ];
+    v.extend(common_params(2.0));
+    v
+}
+
+/// The exact velocity and pressure at `x` and time `t`, eqs. (63)-(65).
+pub fn exact(x: &Vector<2>, t: f64, re: f64) -> (Vector<2>, f64) {
+    let b = -8.0 * PI * PI / re;
+    let e = U * (b * t).exp();
+    let (sx, cx) = (2.0 * PI * x[0]).sin_cos();
+    let (sy, cy) = (2.0 * PI * x[1]).sin_cos();
+    let u = Vector::<2>::new(-e * cx * sy, e * sx * cy);
+    let p = -e * e * ((4.0 * PI * x[0]).cos() + (4.0 * PI * x[1]).cos()) / 4.0;
+    (u, p)
+}
+
+fn switch(p: &Params, key: &str, all: bool) -> bool {
+    match p.str(key) {
+        "on" => true,
+        "off" => false,
+        _ => all,
+    }
+}
+
+struct TaylorGreen {
+    sim: Simulation<2>,
+    re: f64,
+    l1_max: f64,
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let sim = simulation(p)?;
+    Ok(Box::new(TaylorGreen {
+        sim,
+        re: p.float("re"),
+        l1_max: 0.0,
+    }))
+}
+
+/// The simulation the scene runs, for benchmarks and tests that drive steps directly.
+pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
+    let nx = p.int("nx") as usize;
+    let re = p.float("re");
+    let hdx = p.float("hdx");
+    let dx = L / nx as f64;
+    let h = hdx * dx;
+    let kind = KernelKind::from_name(p.str("kernel")).expect("checked choice");
+    let kernel = Kernel::new(kind, 2);
+    let scheme_name = SchemeName::from_name(p.str("scheme")).expect("checked choice");
+    let all = p.str("corrections") == "all";
+    let corrections = Corrections {
+        continuity: switch(p, "corr_continuity", all),
+        pressure: switch(p, "corr_pressure", all),
+        momentum: switch(p, "corr_momentum", all),
+    };
+    let settings = FluidSettings {
+        rho0: RHO0,
+        c0: C0,
+        u_ref: U,
+        h,
+        w_dx: kernel.w(dx, h),
+        nu: Some(U * L / re),
+        alpha: None,
+        edac_alpha: p.float("edac_alpha"),
+        density: DensityModel::Summation,
+        pst: Pst::from_name(p.str("pst")).expect("checked choice"),
+        corrections,
+        ipst_tol: p.float("ipst_tol"),
+        ipst_max_iter: p.int("ipst_max_iter") as usize,
+        gravity: [0.0; 3],
+        internal_flow: true,
+    };
+    let scheme = scheme_name.fluid_scheme(&settings);
+
+    // Lattice at cell centres, optionally perturbed (seeded), initialised from the exact
+    // solution at t = 0 at the perturbed positions.
+    let perturb = p.float("perturb");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(p.int("seed") as u64);
+    let domain = Domain::periodic([0.0, 0.0], [L, L]);
+    let mut init = FluidInit::default();
+    for j in 0..nx {
+        for i in 0..nx {
+            let mut x = Vector::<2>::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx);
+            if perturb > 0.0 {
+                x[0] += (rng.gen::<f64>() - 0.5) * perturb * dx;
+                x[1] += (rng.gen::<f64>() - 0.5) * perturb * dx;
+                domain.wrap(&mut x);
+            }
+            let (u, pr) = exact(&x, 0.0, re);
+            init.x.push(x);
+            init.u.push(u);
+            init.p.push(pr);
+            init.m.push(RHO0 * dx * dx);
+            init.rho.push(RHO0);
+        }
+    }
+    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
+    let time = TimeSettings {
+        cfl: p.float("cfl"),
+        c0: C0,
+        u_ref: U,
+        blowup_factor: 10.0,
+    };
+    Simulation::new(domain, kernel, fluid, scheme, time, false)
+        .map_err(|e| format!("scene `taylor_green`: {e}"))
+}
+
+/// Parameters of this scene from `key=value` strings over the defaults.
+pub fn params_from(sets: &[&str]) -> Result<Params, String> {
+    ENTRY.params_from_sets(&sets.iter().map(|s| s.to_string()).collect::<Vec<_>>())
+}
+
+/// Error norms of the current state against the exact solution.
+struct Errors {
+    u_max: f64,
+    u_max_exact: f64,
+    l1: f64,
+    p_l1: f64,
+    ke: f64,
+    ke_exact: f64,
+}
+
+impl TaylorGreen {
+    fn errors(&self) -> Errors {
+        let f = self.sim.fluid();
+        let t = self.sim.time();
+        let n = f.len() as f64;
+        let (mut err, mut mag_e, mut ke, mut ke_e, mut u_max) = (0.0, 0.0, 0.0, 0.0, 0.0f64);
+        let (mut p_mean, mut pe_mean, mut pe_max) = (0.0, 0.0, 0.0f64);
+        let mut pe = Vec::with_capacity(f.len());
+        // Sequential sums in particle-id order: the metrics do not depend on threads.
+        let order = f.by_id(&(0..f.len() as u32).collect::<Vec<_>>());
+        for &k in &order {
+            let k = k as usize;
+            let (ue, pex) = exact(&f.x[k], t, self.re);
+            let speed = f.u[k].norm();
+            err += (speed - ue.norm()).abs();
+            mag_e += ue.norm();
+            ke += 0.5 * f.m[k] * speed * speed;
+            ke_e += 0.5 * f.m[k] * ue.norm_squared();
+            u_max = u_max.max(speed);
+            p_mean += f.p[k];
+            pe_mean += pex;
+            pe_max = pe_max.max(pex.abs());
+            pe.push((k, pex));
+        }
+        p_mean /= n;
+        pe_mean /= n;
+        let p_err: f64 = pe
+            .iter()
+            .map(|&(k, pex)| ((f.p[k] - p_mean) - (pex - pe_mean)).abs())
+            .sum::<f64>()
+            / n;
+        let b = -8.0 * PI * PI / self.re;
+        Errors {
+            u_max,
+            u_max_exact: U * (b * t).exp(),
+            l1: err / mag_e,
+            p_l1: p_err / pe_max,
+            ke,
+            ke_exact: ke_e,
+        }
+    }
+}
+
+impl TaylorGreen {
+    /// Largest |u~ - u|: how fast the shifting moves particles relative to the flow.
+    fn shift_max(&self) -> f64 {
+        let f = self.sim.fluid();
+        f.u_hat()
+            .iter()
+            .zip(&f.u)
+            .map(|(a, b)| (a - b).norm())
+            .fold(0.0, f64::max)
+    }
+}
+
+impl SceneRun for TaylorGreen {
+    fn particles(&self) -> usize {
+        self.sim.fluid().len()
+    }
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    fn steps(&self) -> u64 {
+        self.sim.steps()
+    }
+    fn plan(&self) -> String {
+        format!(
+            "body `fluid`: {} particles, h = {:.4e}, kernel {:?}, periodic unit square\n{}",
+            self.sim.fluid().len(),
+            self.sim.fluid().h,
+            self.sim.kernel.kind(),
+            self.sim.state.scheme
+        )
+    }
+    fn advance_to(&mut self, t: f64, on_step: &mut dyn FnMut(f64, u64)) -> Result<(), Divergence> {
+        self.sim.advance_to(t, |s| on_step(s.time(), s.steps()))
+    }
+    fn sample(&mut self) -> Vec<(&'static str, f64)> {
+        let e = self.errors();
+        self.l1_max = self.l1_max.max(e.l1);
+        vec![
+            ("t", self.sim.time()),
+            ("u_max", e.u_max),
+            ("u_max_exact", e.u_max_exact),
+            ("l1_velocity", e.l1),
+            (
+                "decay_rel_error",
+                (e.u_max - e.u_max_exact).abs() / e.u_max_exact,
+            ),
+            ("p_l1", e.p_l1),
+            ("kinetic_energy", e.ke),
+            ("kinetic_energy_exact", e.ke_exact),
+            ("ipst_iterations", self.sim.last_ipst_iterations() as f64),
+            ("shift_max", self.shift_max()),
+        ]
+    }
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
+        let f = self.sim.fluid();
+        let t = self.sim.time();
+        let pts: Vec<[f64; 3]> = f.x.iter().map(|x| [x[0], x[1], 0.0]).collect();
+        let vel: Vec<[f64; 3]> = f.u.iter().map(|u| [u[0], u[1], 0.0]).collect();
+        let speed: Vec<f64> = f.u.iter().map(|u| u.norm()).collect();
+        let p_exact: Vec<f64> = f.x.iter().map(|x| exact(x, t, self.re).1).collect();
+        let name = format!("fluid_{index:05}.vtu");
+        write_vtu(
+            &dir.join(&name),
+            &pts,
+            &[
+                Field::Vector("velocity", vel),
+                Field::Scalar("speed", speed),
+                Field::Scalar("pressure", f.p.clone()),
+                Field::Scalar("pressure_exact", p_exact),
+                Field::Scalar("density", f.rho.clone()),
+                Field::Int("id", f.id.iter().map(|&i| i as i64).collect()),
+            ],
+        )?;
+        Ok(vec![("fluid".into(), name)])
+    }
+    fn metrics(&self) -> BTreeMap<String, f64> {
+        let e = self.errors();
+        let mut m = BTreeMap::new();
+        m.insert("l1_velocity_final".into(), e.l1);
+        m.insert("l1_velocity_max".into(), self.l1_max.max(e.l1));
+        m.insert(
+            "umax_decay_rel_error".into(),
+            (e.u_max - e.u_max_exact).abs() / e.u_max_exact,
+        );
+        m.insert("p_l1_final".into(), e.p_l1);
+        m.insert(
+            "kinetic_energy_rel_error".into(),
+            (e.ke - e.ke_exact).abs() / e.ke_exact,
+        );
+        m
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// du/dt of the exact solution: -grad p / rho + nu lap u = -pi (sin 4 pi x, sin 4 pi y) + b u.
+    fn exact_acceleration(x: &Vector<2>, re: f64) -> Vector<2> {
+        let b = -8.0 * PI * PI / re;
+        let (u, _) = exact(x, 0.0, re);
+        Vector::<2>::new(-PI * (4.0 * PI * x[0]).sin(), -PI * (4.0 * PI * x[1]).sin()) + u * b
+    }
+
+    #[test]
+    fn initial_acceleration_matches_the_exact_solution() {
+        // (tvf is left out: its pressure comes from the summation density, not the exact field.)
+        for scheme in ["edac", "ctvf"] {
+            let p = params_from(&["nx=50", &format!("scheme={scheme}"), "pst=sun"]).unwrap();
+            let sim = simulation(&p).unwrap();
+            let f = sim.fluid();
+            let (mut err, mut norm) = (0.0, 0.0);
+            for i in 0..f.len() {
+                let e = exact_acceleration(&f.x[i], 100.0);
+                err += (sim.state.rates.du[i] - e).norm();
+                norm += e.norm();
+            }
+            let rel = err / norm;
+            eprintln!("{scheme}: relative L1 error of du/dt at t = 0: {rel:.3e}");
+            assert!(rel < 0.02, "{scheme}: {rel}");
+        }
+    }
+}

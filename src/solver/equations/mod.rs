@@ -1,0 +1,101 @@
+//! Physics terms, one function per term, each citing the equation it discretises.
+//!
+//! Conventions (those of the CTVF paper and `shared/SEED-NOTES.md`): `a` is the particle
+//! being updated, `b` a neighbour, `x_ab = x_a - x_b`, `grad W = grad_a W_ab`,
+//! `V_b = m_b / rho_b`, `du = u~ - u` (the shifting part of the transport velocity), and the
+//! SPH divergence `(div f)_a = -sum_b V_b f_ab . grad W`. Functions here hold no loops, no
+//! allocation and no parallelism: the passes in `scheme` do that.
+
+pub mod artificial_viscosity;
+pub mod continuity;
+pub mod edac;
+pub mod momentum;
+pub mod shifting;
+pub mod viscosity;
+
+use crate::solver::math::Vector;
+
+/// One neighbour pair, computed once per pass and shared by every term.
+#[derive(Clone, Copy, Debug)]
+pub struct Pair<const D: usize> {
+    /// x_a - x_b (minimum image when periodic).
+    pub xij: Vector<D>,
+    /// |x_ab|^2.
+    pub r2: f64,
+    /// Smoothing length h_ab.
+    pub h: f64,
+    /// W_ab.
+    pub wij: f64,
+    /// grad_a W_ab.
+    pub dwij: Vector<D>,
+}
+
+/// The values of one particle a term may read, gathered once per particle.
+#[derive(Clone, Copy, Debug)]
+pub struct Point<const D: usize> {
+    /// Momentum velocity u.
+    pub u: Vector<D>,
+    /// Transport velocity u~ (equal to u without shifting).
+    pub u_hat: Vector<D>,
+    /// Mass.
+    pub m: f64,
+    /// Density.
+    pub rho: f64,
+    /// Pressure.
+    pub p: f64,
+}
+
+impl<const D: usize> Point<D> {
+    /// Volume m / rho.
+    #[inline(always)]
+    pub fn v(&self) -> f64 {
+        self.m / self.rho
+    }
+
+    /// u~ - u.
+    #[inline(always)]
+    pub fn du(&self) -> Vector<D> {
+        self.u_hat - self.u
+    }
+}
+
+/// The regularisation 0.01 h^2 in the denominators of eqs. (26), (27) and (29).
+#[inline(always)]
+pub(crate) fn eps2(h: f64) -> f64 {
+    0.01 * h * h
+}
+
+#[cfg(test)]
+pub(crate) mod test_support {
+    //! Two-particle fixtures shared by the term tests.
+    use super::*;
+    use crate::solver::kernel::{Kernel, KernelKind};
+
+    pub fn point(u: [f64; 2], u_hat: [f64; 2], m: f64, rho: f64, p: f64) -> Point<2> {
+        Point {
+            u: Vector::<2>::from(u),
+            u_hat: Vector::<2>::from(u_hat),
+            m,
+            rho,
+            p,
+        }
+    }
+
+    /// The pair (a, b) and the reversed pair (b, a) for positions xa, xb.
+    pub fn pairs(xa: [f64; 2], xb: [f64; 2], h: f64) -> (Pair<2>, Pair<2>) {
+        let k = Kernel::new(KernelKind::QuinticSpline, 2);
+        let make = |xij: Vector<2>| {
+            let r2 = xij.norm_squared();
+            let (w, f) = k.w_and_grad_factor(r2.sqrt(), h);
+            Pair {
+                xij,
+                r2,
+                h,
+                wij: w,
+                dwij: xij * f,
+            }
+        };
+        let xab = Vector::<2>::from(xa) - Vector::<2>::from(xb);
+        (make(xab), make(-xab))
+    }
+}

@@ -1,0 +1,17 @@
+//! The SPH solver library. It knows nothing of problem files, caches, plots or the CLI.
+//!
+//! - [`kernel`]: smoothing kernels; [`nnps`]: neighbour search;
+//! - [`particles`]: per-body storage; [`equations`]: one function per physics term;
+//! - [`scheme`]: named compositions of the terms and the passes that run them;
+//! - [`integrator`]: kick-drift-kick and the time step; [`simulation`]: the run loop;
+//! - [`output`]: ParaView snapshots, time series and the run summary.
+
+pub mod equations;
+pub mod integrator;
+pub mod kernel;
+pub mod math;
+pub mod nnps;
+pub mod output;
+pub mod particles;
+pub mod scheme;
+pub mod simulation;

@@ -1,0 +1,113 @@
+//! `summary.json`: the record of one run, in the shape of DESIGN.md's contract.
+
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// How a run ended.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Status {
+    /// Reached `tf`.
+    Completed,
+    /// The physics blew up: a reproducible result.
+    Diverged,
+    /// Anything else stopped it (I/O error, interruption): never a done case.
+    Failed,
+}
+
+/// Where and from what a result was computed.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Provenance {
+    /// Crate version.
+    pub version: String,
+    /// Scheme version: bumped whenever results change for the same parameters.
+    pub scheme_version: String,
+    /// Git commit the binary was built from.
+    pub git_commit: String,
+    /// Whether the tree had uncommitted changes at build time.
+    pub git_dirty: bool,
+    /// rustc that built it.
+    pub rustc: String,
+    /// Host name.
+    pub host: String,
+    /// Start, RFC 3339.
+    pub started: String,
+    /// End, RFC 3339.
+    pub finished: String,
+}
+
+/// Bumped whenever the solver's results change for unchanged parameters; part of every
+/// cache key (with the crate version).
+pub const SCHEME_VERSION: &str = "1";
+
+impl Provenance {
+    /// Provenance of this binary, for a run that started at `started`.
+    pub fn now(started: chrono::DateTime<chrono::Utc>) -> Self {
+        Self {
+            version: env!("CARGO_PKG_VERSION").into(),
+            scheme_version: SCHEME_VERSION.into(),
+            git_commit: env!("SPHREPRO_GIT_COMMIT").into(),
+            git_dirty: env!("SPHREPRO_GIT_DIRTY") == "true",
+            rustc: env!("SPHREPRO_RUSTC").into(),
+            host: hostname(),
+            started: started.to_rfc3339(),
+            finished: chrono::Utc::now().to_rfc3339(),
+        }
+    }
+}
+
+fn hostname() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::fs::read_to_string("/etc/hostname"))
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|_| std::env::var("HOSTNAME").unwrap_or_else(|_| "unknown".into()))
+}
+
+/// The contents of `summary.json`.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Resolved parameters (defaults filled in).
+    pub params: BTreeMap<String, serde_json::Value>,
+    /// Particle count (all bodies).
+    pub particles: usize,
+    /// Time steps taken.
+    pub steps: u64,
+    /// Simulated time reached.
+    pub final_time: f64,
+    /// Wall-clock seconds of the whole run.
+    pub wall_seconds: f64,
+    /// particles x steps / seconds spent stepping.
+    pub particle_steps_per_second: f64,
+    /// Rayon threads.
+    pub threads: usize,
+    /// How it ended.
+    pub status: Status,
+    /// Why it diverged or failed.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub reason: Option<String>,
+    /// The step at which it diverged.
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub step: Option<u64>,
+    /// Named error norms and validation figures.
+    pub metrics: BTreeMap<String, f64>,
+    /// Provenance.
+    pub provenance: Provenance,
+}
+
+impl Summary {
+    /// Writes `DIR/summary.json` atomically.
+    pub fn write(&self, dir: &Path) -> std::io::Result<()> {
+        let json = serde_json::to_string_pretty(self).expect("summary serialises");
+        super::write_atomic(&dir.join("summary.json"), json.as_bytes())
+    }
+
+    /// Reads `DIR/summary.json`.
+    pub fn read(dir: &Path) -> Result<Self, String> {
+        let path = dir.join("summary.json");
+        let s = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        serde_json::from_str(&s).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}

@@ -1,0 +1,392 @@
+//! Schemes: named compositions of the term functions in `equations`, as ordered passes.
+//!
+//! A scheme is a [`FluidScheme`] value: what the density, pressure, pressure gradient,
+//! viscosity and transport velocity are. `edac`, `tvf` and `ctvf` are three values of it
+//! ([`SchemeName::fluid_scheme`]), not three code paths; "with and without corrections" is
+//! the [`Corrections`] field. [`Display`](std::fmt::Display) prints the plan, written at the
+//! top of every run log.
+
+mod passes;
+
+pub use passes::{ipst_chi_reference, FluidPasses};
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// The scheme names `--set scheme=...` accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SchemeName {
+    /// EDAC of Ramachandran & Puri (2019) for internal flows: EDAC pressure, summation
+    /// density, Adami (2013) transport velocity driven by a background pressure, the
+    /// Basa-Quinlan-Lastiwka mean-pressure correction (as PySPH's `EDACScheme`).
+    Edac,
+    /// The TVF of Adami et al. (2013): equation of state, background-pressure transport
+    /// velocity, artificial stress.
+    Tvf,
+    /// The corrected transport-velocity formulation of Adepu & Ramachandran: EDAC pressure
+    /// with the transport-velocity correction terms, shifting by SPST or IPST.
+    Ctvf,
+}
+
+impl SchemeName {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["edac", "tvf", "ctvf"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "edac" => Self::Edac,
+            "tvf" => Self::Tvf,
+            "ctvf" => Self::Ctvf,
+            _ => return None,
+        })
+    }
+}
+
+/// Particle shifting technique for CTVF.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pst {
+    /// Sun et al. (2019), CTVF eq. (36).
+    Sun,
+    /// Iterative PST of Huang et al. (2019), CTVF eqs. (37)-(41).
+    Ipst,
+    /// No shifting: particles move with u.
+    None,
+}
+
+impl Pst {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["sun", "ipst", "none"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "sun" => Self::Sun,
+            "ipst" => Self::Ipst,
+            "none" => Self::None,
+            _ => return None,
+        })
+    }
+}
+
+/// The CTVF correction terms, each a switch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Corrections {
+    /// The `div(rho (u~ - u))` term of eq. (25).
+    pub continuity: bool,
+    /// The transport-velocity terms of eq. (26).
+    pub pressure: bool,
+    /// The `-u div(u~ - u)` term of eq. (19).
+    pub momentum: bool,
+}
+
+impl Corrections {
+    /// Every correction on (the paper's scheme).
+    pub const ALL: Self = Self {
+        continuity: true,
+        pressure: true,
+        momentum: true,
+    };
+    /// Every correction off (TVF-like transport on an EDAC scheme).
+    pub const NONE: Self = Self {
+        continuity: false,
+        pressure: false,
+        momentum: false,
+    };
+}
+
+/// How the density is found.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum DensityModel {
+    /// `rho_a = sum_b m_b W_ab` (internal flows).
+    Summation,
+    /// Evolved by the continuity equation, eq. (25) (free-surface flows).
+    Continuity,
+}
+
+/// How the pressure is found.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum PressureModel {
+    /// Evolved by the EDAC equation (26) with artificial sound speed `cs` and pressure
+    /// diffusion `nu` (eq. 24).
+    Edac {
+        /// Artificial speed of sound c_s.
+        cs: f64,
+        /// nu_edac.
+        nu: f64,
+    },
+    /// The linear equation of state (8), `p = c0^2 (rho - rho0)`.
+    StateEquation {
+        /// Speed of sound c_0.
+        c0: f64,
+        /// Reference density rho_0.
+        rho0: f64,
+    },
+}
+
+/// Which discretisation of the pressure gradient.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum PressureGradient {
+    /// Eq. (27): `-m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W`, optionally with the local mean
+    /// pressure subtracted from both (BQL), which makes the force depend on pressure
+    /// differences only.
+    Symmetric {
+        /// Subtract the neighbour-mean pressure (Basa, Quinlan & Lastiwka 2009).
+        bql: bool,
+    },
+    /// Adami et al. (2013), optionally with the local mean pressure subtracted (BQL).
+    Adami {
+        /// Subtract the neighbour-mean pressure (Basa, Quinlan & Lastiwka 2009).
+        bql: bool,
+    },
+}
+
+/// The homogenisation that drives the transport velocity.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub enum Shifting {
+    /// Adami et al. (2013): a background pressure `pb`.
+    BackgroundPressure {
+        /// Background pressure p_b.
+        pb: f64,
+    },
+    /// Sun et al. (2019), eq. (36): `-(Ma 2h c0/dt) sum V_b [1 + R (W/W(dx))^n] grad W`.
+    Sun2019 {
+        /// Mach number times speed of sound: the reference velocity U = Ma c0.
+        ma_c0: f64,
+        /// Kernel value at the initial spacing, W(dx).
+        w_dx: f64,
+        /// R (0.2 in the paper).
+        r: f64,
+        /// n (4 in the paper).
+        n: i32,
+    },
+    /// Huang et al. (2019) iterative shifting, eqs. (37)-(41).
+    Ipst {
+        /// U_max of eq. (37).
+        u_max: f64,
+        /// Convergence tolerance on `|max chi - chi_ref| / chi_ref` (eq. 39).
+        tol: f64,
+        /// Iteration cap per time step.
+        max_iter: usize,
+        /// chi_ref of eq. (39), from the initial configuration.
+        chi_ref: f64,
+    },
+}
+
+/// The transport velocity a scheme declares.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Transport {
+    /// What makes u~ differ from u.
+    pub shifting: Shifting,
+    /// Which CTVF correction terms are on.
+    pub corrections: Corrections,
+}
+
+/// Everything a fluid body's equations depend on: one value per scheme.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FluidScheme {
+    /// The scheme this value was built for (for logs and summaries).
+    pub name: SchemeName,
+    /// Density model.
+    pub density: DensityModel,
+    /// Pressure model.
+    pub pressure: PressureModel,
+    /// Pressure-gradient form.
+    pub pressure_gradient: PressureGradient,
+    /// Kinematic viscosity (Morris term), if any.
+    pub viscosity: Option<f64>,
+    /// Artificial viscosity `(alpha, c)`, if any.
+    pub artificial_viscosity: Option<(f64, f64)>,
+    /// Transport velocity, if any.
+    pub transport: Option<Transport>,
+    /// Body force per unit mass (x, y, z; the first D components are used).
+    pub gravity: [f64; 3],
+}
+
+/// What a scene gives a scheme name to build a [`FluidScheme`] from.
+#[derive(Clone, Copy, Debug)]
+pub struct FluidSettings {
+    /// Reference density rho_0.
+    pub rho0: f64,
+    /// Speed of sound c_0.
+    pub c0: f64,
+    /// Reference (maximum) velocity U.
+    pub u_ref: f64,
+    /// Smoothing length h.
+    pub h: f64,
+    /// W(dx) for the Sun 2019 shifting.
+    pub w_dx: f64,
+    /// Kinematic viscosity, if any.
+    pub nu: Option<f64>,
+    /// Artificial viscosity alpha, if any.
+    pub alpha: Option<f64>,
+    /// alpha_edac of eq. (24).
+    pub edac_alpha: f64,
+    /// Density model for CTVF (summation for internal flows, continuity with a free surface).
+    pub density: DensityModel,
+    /// Shifting technique for CTVF.
+    pub pst: Pst,
+    /// CTVF corrections.
+    pub corrections: Corrections,
+    /// IPST tolerance and iteration cap.
+    pub ipst_tol: f64,
+    /// IPST iteration cap.
+    pub ipst_max_iter: usize,
+    /// Gravity.
+    pub gravity: [f64; 3],
+    /// An internal flow (no free surface): the pressure level is arbitrary, so the
+    /// pressure gradient uses the local mean-pressure correction (BQL).
+    pub internal_flow: bool,
+}
+
+impl SchemeName {
+    /// The composition this scheme name stands for.
+    pub fn fluid_scheme(self, s: &FluidSettings) -> FluidScheme {
+        let artificial_viscosity = s.alpha.filter(|&a| a > 0.0).map(|a| (a, s.c0));
+        let edac = PressureModel::Edac {
+            cs: s.c0,
+            nu: crate::solver::equations::edac::nu_edac(s.edac_alpha, s.h, s.c0),
+        };
+        // Adami et al. (2013): p_b = rho0 c0^2, applied over half a step (eq. 55), as
+        // PySPH's TVF integrator does. PySPH's EDAC scheme integrates with a midpoint
+        // predictor-corrector whose final stage sets u~ = u + dt a_c, i.e. twice the
+        // homogenisation of eq. (55): in our kick-drift-kick that is p_b = 2 rho0 c0^2.
+        let background = |factor: f64| Transport {
+            shifting: Shifting::BackgroundPressure {
+                pb: factor * s.rho0 * s.c0 * s.c0,
+            },
+            corrections: Corrections::NONE,
+        };
+        match self {
+            SchemeName::Edac => FluidScheme {
+                name: self,
+                density: DensityModel::Summation,
+                pressure: edac,
+                pressure_gradient: PressureGradient::Adami { bql: true },
+                viscosity: s.nu,
+                artificial_viscosity,
+                transport: Some(background(2.0)),
+                gravity: s.gravity,
+            },
+            SchemeName::Tvf => FluidScheme {
+                name: self,
+                density: DensityModel::Summation,
+                pressure: PressureModel::StateEquation {
+                    c0: s.c0,
+                    rho0: s.rho0,
+                },
+                pressure_gradient: PressureGradient::Adami { bql: false },
+                viscosity: s.nu,
+                artificial_viscosity,
+                transport: Some(background(1.0)),
+                gravity: s.gravity,
+            },
+            SchemeName::Ctvf => {
+                let shifting = match s.pst {
+                    Pst::Sun => Some(Shifting::Sun2019 {
+                        ma_c0: s.u_ref,
+                        w_dx: s.w_dx,
+                        r: 0.2,
+                        n: 4,
+                    }),
+                    Pst::Ipst => Some(Shifting::Ipst {
+                        u_max: s.u_ref,
+                        tol: s.ipst_tol,
+                        max_iter: s.ipst_max_iter,
+                        chi_ref: f64::NAN, // measured on the initial configuration
+                    }),
+                    Pst::None => None,
+                };
+                FluidScheme {
+                    name: self,
+                    density: s.density,
+                    pressure: edac,
+                    pressure_gradient: PressureGradient::Symmetric {
+                        bql: s.internal_flow,
+                    },
+                    viscosity: s.nu,
+                    artificial_viscosity,
+                    transport: shifting.map(|shifting| Transport {
+                        shifting,
+                        corrections: s.corrections,
+                    }),
+                    gravity: s.gravity,
+                }
+            }
+        }
+    }
+}
+
+impl fmt::Display for FluidScheme {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(f, "scheme {:?}", self.name)?;
+        match self.density {
+            DensityModel::Summation => {
+                writeln!(f, "  density      summation: rho_a = sum m_b W_ab")?
+            }
+            DensityModel::Continuity => writeln!(f, "  density      continuity, CTVF eq. (25)")?,
+        }
+        match self.pressure {
+            PressureModel::Edac { cs, nu } => writeln!(
+                f,
+                "  pressure     EDAC, CTVF eq. (26): c_s = {cs}, nu_edac = {nu:.6e}"
+            )?,
+            PressureModel::StateEquation { c0, rho0 } => writeln!(
+                f,
+                "  pressure     state equation (8): c0 = {c0}, rho0 = {rho0}"
+            )?,
+        }
+        match self.pressure_gradient {
+            PressureGradient::Symmetric { bql } => writeln!(
+                f,
+                "  grad p       symmetric, CTVF eq. (27){}",
+                if bql {
+                    " with BQL mean-pressure correction"
+                } else {
+                    ""
+                }
+            )?,
+            PressureGradient::Adami { bql } => writeln!(
+                f,
+                "  grad p       Adami 2013{}",
+                if bql {
+                    " with BQL mean-pressure correction"
+                } else {
+                    ""
+                }
+            )?,
+        }
+        if let Some(nu) = self.viscosity {
+            writeln!(f, "  viscosity    Morris, nu = {nu:.6e}")?;
+        }
+        if let Some((alpha, c)) = self.artificial_viscosity {
+            writeln!(
+                f,
+                "  art. visc.   Monaghan eq. (28): alpha = {alpha}, c = {c}"
+            )?;
+        }
+        match &self.transport {
+            None => writeln!(f, "  transport    none: particles move with u")?,
+            Some(t) => {
+                match t.shifting {
+                    Shifting::BackgroundPressure { pb } => writeln!(f, "  transport    background pressure p_b = {pb} (Adami 2013), artificial stress")?,
+                    Shifting::Sun2019 { r, n, .. } => writeln!(f, "  transport    Sun 2019 PST, eq. (36): R = {r}, n = {n}; artificial stress")?,
+                    Shifting::Ipst { tol, max_iter, .. } => writeln!(f, "  transport    IPST, eqs. (37)-(41): tol = {tol}, max {max_iter} iterations; artificial stress")?,
+                }
+                let c = t.corrections;
+                writeln!(
+                    f,
+                    "  corrections  continuity (25): {}, pressure (26): {}, momentum (19): {}",
+                    c.continuity, c.pressure, c.momentum
+                )?;
+            }
+        }
+        let g = self.gravity;
+        if g.iter().any(|&v| v != 0.0) {
+            writeln!(f, "  gravity      {g:?}")?;
+        }
+        Ok(())
+    }
+}

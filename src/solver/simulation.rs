@@ -1,0 +1,352 @@
+//! A simulation: a domain, the bodies, a scheme and the kick-drift-kick loop.
+
+use crate::solver::integrator;
+use crate::solver::kernel::Kernel;
+use crate::solver::math::Vector;
+use crate::solver::nnps::{CellList, Domain};
+use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::scheme::{
+    ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, PressureModel, Shifting,
+};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Why a run stopped early: the physics blew up. A result, not a crash.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Divergence {
+    /// What was found.
+    pub reason: String,
+    /// The step after which it was found.
+    pub step: u64,
+    /// Simulated time at that step.
+    pub time: f64,
+}
+
+/// Settings of the time loop.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct TimeSettings {
+    /// The factor of eq. (61).
+    pub cfl: f64,
+    /// Speed of sound used in the acoustic limit.
+    pub c0: f64,
+    /// Reference velocity: the acoustic limit uses max(u_ref, max |u|).
+    pub u_ref: f64,
+    /// A speed above `blowup_factor * c0` counts as a blow-up (weakly compressible flow
+    /// has no business there), so a run that grows without turning NaN still stops.
+    pub blowup_factor: f64,
+}
+
+/// The evolving state that a checkpoint must hold to resume bit for bit.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct State<const D: usize> {
+    /// The fluid body.
+    pub fluid: Fluid<D>,
+    /// Its rates from the last evaluation (the first kick of the next step uses them).
+    pub rates: FluidRates<D>,
+    /// Simulated time.
+    pub time: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// Largest speed at the last step (for the next time step).
+    pub u_max: f64,
+    /// The scheme, with quantities measured at the start (IPST chi_ref).
+    pub scheme: FluidScheme,
+}
+
+/// One simulation of one fluid body in a domain.
+pub struct Simulation<const D: usize> {
+    /// The box.
+    pub domain: Domain<D>,
+    /// The smoothing kernel.
+    pub kernel: Kernel,
+    /// Time-loop settings.
+    pub time_settings: TimeSettings,
+    /// Everything that evolves.
+    pub state: State<D>,
+    cells: CellList<D>,
+    passes: FluidPasses<D>,
+}
+
+impl<const D: usize> Simulation<D> {
+    /// Sets up the neighbour search, sorts the particles by cell and evaluates the initial
+    /// rates. `free_surface` selects the IPST reference (sec. 3.3.2).
+    pub fn new(
+        domain: Domain<D>,
+        kernel: Kernel,
+        fluid: Fluid<D>,
+        mut scheme: FluidScheme,
+        time_settings: TimeSettings,
+        free_surface: bool,
+    ) -> Result<Self, String> {
+        let radius = kernel.support() * fluid.h;
+        for k in 0..D {
+            if domain.periodic[k] && domain.length(k) < 2.0 * radius {
+                return Err(format!(
+                    "periodic box length {} along axis {k} is shorter than two kernel radii ({radius}): increase nx or lower hdx",
+                    domain.length(k)
+                ));
+            }
+        }
+        let mut cells = CellList::new(domain, radius);
+        let n = fluid.len();
+        let transport = scheme.transport.is_some();
+        let rates = FluidRates::new(
+            n,
+            matches!(scheme.pressure, PressureModel::Edac { .. }),
+            scheme.density == DensityModel::Continuity,
+            transport,
+        );
+        let mut state = State {
+            fluid,
+            rates,
+            time: 0.0,
+            steps: 0,
+            u_max: 0.0,
+            scheme,
+        };
+        Self::rebuild(&domain, &mut cells, &mut state.fluid);
+        if let Some(t) = scheme.transport.as_mut() {
+            if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
+                *chi_ref = ipst_chi_reference(&state.fluid, &cells, &kernel, free_surface);
+            }
+        }
+        state.scheme = scheme;
+        let passes = FluidPasses::new(&scheme, domain, radius);
+        let mut sim = Self {
+            domain,
+            kernel,
+            time_settings,
+            state,
+            cells,
+            passes,
+        };
+        sim.state.u_max = sim.max_speed();
+        // Initial accelerations for the first half kick; the pressure is the initial one.
+        if sim.state.scheme.density == DensityModel::Summation {
+            FluidPasses::summation_density(&mut sim.state.fluid, &sim.cells, &sim.kernel);
+        }
+        if let PressureModel::StateEquation { .. } = sim.state.scheme.pressure {
+            FluidPasses::update_density_and_pressure(
+                &mut sim.state.fluid,
+                &sim.cells,
+                &sim.kernel,
+                &sim.state.scheme,
+                &mut sim.state.rates,
+                0.0,
+            );
+        }
+        let dt = sim.nominal_dt();
+        sim.evaluate_accelerations(dt);
+        Ok(sim)
+    }
+
+    /// Resumes from a checkpointed state (the cell list is rebuilt from the positions,
+    /// which are already in cell order, so the neighbour order is the same).
+    pub fn resume(
+        domain: Domain<D>,
+        kernel: Kernel,
+        time_settings: TimeSettings,
+        state: State<D>,
+    ) -> Self {
+        let radius = kernel.support() * state.fluid.h;
+        let mut cells = CellList::new(domain, radius);
+        cells.update(&state.fluid.x);
+        let passes = FluidPasses::new(&state.scheme, domain, radius);
+        Self {
+            domain,
+            kernel,
+            time_settings,
+            state,
+            cells,
+            passes,
+        }
+    }
+
+    /// The fluid body.
+    pub fn fluid(&self) -> &Fluid<D> {
+        &self.state.fluid
+    }
+
+    /// Simulated time.
+    pub fn time(&self) -> f64 {
+        self.state.time
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.state.steps
+    }
+
+    /// IPST iterations in the last step.
+    pub fn last_ipst_iterations(&self) -> usize {
+        self.passes.last_ipst_iterations
+    }
+
+    fn rebuild(domain: &Domain<D>, cells: &mut CellList<D>, fluid: &mut Fluid<D>) {
+        fluid.x.par_iter_mut().for_each(|x| domain.wrap(x));
+        cells.update(&fluid.x);
+        fluid.reorder(cells.order());
+        cells.mark_reordered();
+    }
+
+    /// The time step of eq. (61) from the current largest speed.
+    pub fn nominal_dt(&self) -> f64 {
+        let s = &self.state.scheme;
+        let g = s.gravity.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let ts = &self.time_settings;
+        integrator::time_step(
+            ts.cfl,
+            self.state.fluid.h,
+            ts.c0,
+            ts.u_ref.max(self.state.u_max),
+            s.viscosity,
+            g,
+        )
+    }
+
+    fn evaluate_accelerations(&mut self, dt_nominal: f64) {
+        let st = &mut self.state;
+        FluidPasses::accelerations(
+            &st.fluid,
+            &self.cells,
+            &self.kernel,
+            &st.scheme,
+            &mut st.rates,
+            dt_nominal,
+        );
+        self.passes.ipst(
+            &st.fluid,
+            &self.domain,
+            &self.kernel,
+            &st.scheme,
+            &mut st.rates,
+            dt_nominal,
+        );
+    }
+
+    /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60).
+    pub fn step(&mut self, max_dt: f64) -> Result<(), Divergence> {
+        let dt_nominal = self.nominal_dt();
+        let dt = dt_nominal.min(max_dt);
+        {
+            let st = &mut self.state;
+            let f = &mut st.fluid;
+            integrator::kick(&mut f.u, &st.rates.du, dt);
+            if let Some(u_hat) = f.u_hat.as_mut() {
+                integrator::transport_velocity(u_hat, &f.u, &st.rates.a_c, dt);
+            }
+            let Fluid { x, u, u_hat, .. } = f;
+            integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
+        }
+        Self::rebuild(&self.domain, &mut self.cells, &mut self.state.fluid);
+        {
+            let st = &mut self.state;
+            if st.scheme.density == DensityModel::Summation {
+                FluidPasses::summation_density(&mut st.fluid, &self.cells, &self.kernel);
+            }
+            FluidPasses::update_density_and_pressure(
+                &mut st.fluid,
+                &self.cells,
+                &self.kernel,
+                &st.scheme,
+                &mut st.rates,
+                dt,
+            );
+        }
+        self.evaluate_accelerations(dt_nominal);
+        let st = &mut self.state;
+        integrator::kick(&mut st.fluid.u, &st.rates.du, dt);
+        st.time += dt;
+        st.steps += 1;
+        self.check()
+    }
+
+    /// Steps until `t_end` is reached exactly (the last step is shortened).
+    pub fn advance_to(
+        &mut self,
+        t_end: f64,
+        mut on_step: impl FnMut(&Self),
+    ) -> Result<(), Divergence> {
+        loop {
+            let remaining = t_end - self.state.time;
+            if remaining <= 1e-12 * t_end.abs().max(1.0) {
+                return Ok(());
+            }
+            self.step(remaining)?;
+            on_step(self);
+        }
+    }
+
+    /// Largest particle speed.
+    pub fn max_speed(&self) -> f64 {
+        self.state
+            .fluid
+            .u
+            .par_iter()
+            .map(|u| u.norm_squared())
+            .reduce(|| 0.0, f64::max)
+            .sqrt()
+    }
+
+    /// Blow-up detection: non-finite fields, speeds beyond the bound, particles outside a
+    /// bounded domain. Also records the largest speed for the next time step.
+    fn check(&mut self) -> Result<(), Divergence> {
+        let f = &self.state.fluid;
+        let domain = &self.domain;
+        // (max |u|^2, first bad particle index) over particles; max and min are exact
+        // and order-independent, so the outcome does not depend on the thread count.
+        let (u2, bad) = (0..f.len())
+            .into_par_iter()
+            .map(|i| {
+                let ok = f.x[i].iter().all(|v| v.is_finite())
+                    && f.u[i].iter().all(|v| v.is_finite())
+                    && f.p[i].is_finite()
+                    && f.rho[i].is_finite()
+                    && domain.contains(&f.x[i]);
+                (
+                    if ok { f.u[i].norm_squared() } else { 0.0 },
+                    if ok { usize::MAX } else { i },
+                )
+            })
+            .reduce(|| (0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.min(b.1)));
+        let fail = |reason: String| Divergence {
+            reason,
+            step: self.state.steps,
+            time: self.state.time,
+        };
+        if bad != usize::MAX {
+            let what = if !f.u[bad].iter().all(|v| v.is_finite()) {
+                "velocity is not finite"
+            } else if !f.p[bad].is_finite() {
+                "pressure is not finite"
+            } else if !f.rho[bad].is_finite() {
+                "density is not finite"
+            } else if !f.x[bad].iter().all(|v| v.is_finite()) {
+                "position is not finite"
+            } else {
+                "particle left the domain"
+            };
+            return Err(fail(format!(
+                "{what} (particle {} of body `{}`, at {:?})",
+                f.id[bad],
+                f.name,
+                f.x[bad].as_slice()
+            )));
+        }
+        let u_max = u2.sqrt();
+        let bound = self.time_settings.blowup_factor * self.time_settings.c0;
+        if u_max > bound {
+            return Err(fail(format!(
+                "max |u| = {u_max:.4e} exceeds {} c0 = {bound:.4e}",
+                self.time_settings.blowup_factor
+            )));
+        }
+        self.state.u_max = u_max;
+        Ok(())
+    }
+
+    /// Positions wrapped into the box, for output.
+    pub fn positions(&self) -> &[Vector<D>] {
+        &self.state.fluid.x
+    }
+}
