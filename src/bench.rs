@@ -33,11 +33,8 @@ pub struct BenchResult {
 }
 
 /// The variants benchmarked: (name, scheme, pst).
-pub const VARIANTS: &[(&str, &str, &str)] = &[
-    ("edac", "edac", "none"),
-    ("ctvf+sun", "ctvf", "sun"),
-    ("ctvf+ipst", "ctvf", "ipst"),
-];
+pub const VARIANTS: &[(&str, &str, &str)] =
+    &[("edac", "edac", "none"), ("ctvf+sun", "ctvf", "sun"), ("ctvf+ipst", "ctvf", "ipst")];
 
 fn status_kb(field: &str) -> u64 {
     std::fs::read_to_string("/proc/self/status")
@@ -105,28 +102,14 @@ pub fn table(results: &[BenchResult]) -> String {
         "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
-        let edac = results
-            .iter()
-            .find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
-        let one = results
-            .iter()
-            .find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
+        let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
+        let one = results.iter().find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
         let cost = edac
-            .map(|e| {
-                format!(
-                    "{:.2}",
-                    e.particle_steps_per_second / r.particle_steps_per_second
-                )
-            })
+            .map(|e| format!("{:.2}", e.particle_steps_per_second / r.particle_steps_per_second))
             .unwrap_or_default();
         let speedup = if r.threads > 1 {
-            one.map(|o| {
-                format!(
-                    "{:.2}",
-                    r.particle_steps_per_second / o.particle_steps_per_second
-                )
-            })
-            .unwrap_or_default()
+            one.map(|o| format!("{:.2}", r.particle_steps_per_second / o.particle_steps_per_second))
+                .unwrap_or_default()
         } else {
             String::new()
         };

@@ -74,10 +74,7 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
-        if let Err(e) = rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-        {
+        if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
             eprintln!("error: cannot start {n} threads: {e}");
             return ExitCode::from(2);
         }
@@ -104,14 +101,7 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Simulate {
-            scene,
-            sets,
-            out,
-            quiet,
-            force,
-            progress_file,
-        } => {
+        Command::Simulate { scene, sets, out, quiet, force, progress_file } => {
             let entry = match scenes::find(&scene) {
                 Ok(e) => e,
                 Err(e) => {
@@ -126,11 +116,7 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let opts = harness::RunOptions {
-                quiet,
-                force,
-                progress_file,
-            };
+            let opts = harness::RunOptions { quiet, force, progress_file };
             match harness::run(entry, &params, &out, &opts) {
                 Ok(s) => match s.status {
                     sphrepro::solver::output::summary::Status::Completed => {
@@ -165,25 +151,19 @@ fn main() -> ExitCode {
                 }
             }
         }
-        Command::Bench {
-            nx,
-            bench_threads,
-            variants,
-            steps,
-            json,
-        } => run_bench(nx, bench_threads, variants, steps, json),
-        Command::BenchCase { variant, nx, steps } => {
-            match bench::run_case(&variant, nx, steps, 5) {
-                Ok(r) => {
-                    println!("{}", serde_json::to_string(&r).expect("serialises"));
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(1)
-                }
-            }
+        Command::Bench { nx, bench_threads, variants, steps, json } => {
+            run_bench(nx, bench_threads, variants, steps, json)
         }
+        Command::BenchCase { variant, nx, steps } => match bench::run_case(&variant, nx, steps, 5) {
+            Ok(r) => {
+                println!("{}", serde_json::to_string(&r).expect("serialises"));
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                ExitCode::from(1)
+            }
+        },
     }
 }
 
@@ -220,10 +200,7 @@ fn run_bench(
                     Ok(o) if o.status.success() => {
                         match serde_json::from_slice::<bench::BenchResult>(&o.stdout) {
                             Ok(r) => {
-                                eprintln!(
-                                    "{:.3} M particle-steps/s",
-                                    r.particle_steps_per_second / 1e6
-                                );
+                                eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
                                 results.push(r);
                             }
                             Err(e) => {

@@ -48,12 +48,7 @@ fn io_err(path: &Path, e: std::io::Error) -> String {
 
 /// Runs `entry` with `params`, writing into `out`. Returns the summary (completed or
 /// diverged), or an error.
-pub fn run(
-    entry: &SceneEntry,
-    params: &Params,
-    out: &Path,
-    opts: &RunOptions,
-) -> Result<Summary, RunError> {
+pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     let started = chrono::Utc::now();
     let t0 = Instant::now();
     // Refuse to overwrite a finished result unless asked.
@@ -62,10 +57,7 @@ pub fn run(
             return Err(RunError::Input(format!(
                 "{} already holds a {} run; pass --force to overwrite it",
                 out.display(),
-                serde_json::to_value(old.status)
-                    .unwrap()
-                    .as_str()
-                    .unwrap_or("finished")
+                serde_json::to_value(old.status).unwrap().as_str().unwrap_or("finished")
             )));
         }
     }
@@ -74,8 +66,7 @@ pub fn run(
     // An old summary must not outlive the run that replaces it.
     let summary_path = out.join("summary.json");
     if summary_path.exists() {
-        std::fs::remove_file(&summary_path)
-            .map_err(|e| RunError::Input(io_err(&summary_path, e)))?;
+        std::fs::remove_file(&summary_path).map_err(|e| RunError::Input(io_err(&summary_path, e)))?;
     }
     let tf = params.float("tf");
     let output_dt = match params.float("output_dt") {
@@ -88,11 +79,7 @@ pub fn run(
     };
     let plan = scene.plan();
     if !opts.quiet {
-        eprintln!(
-            "{} with {} particles\n{plan}",
-            entry.name,
-            scene.particles()
-        );
+        eprintln!("{} with {} particles\n{plan}", entry.name, scene.particles());
     }
     let _ = std::fs::write(out.join("plan.txt"), &plan);
 
@@ -136,10 +123,7 @@ pub fn run(
             let written = scene.snapshot(&vtu_dir, snapshot_index).and_then(|files| {
                 for (body, file) in files {
                     let pvd = out.join(format!("{body}.pvd"));
-                    series
-                        .entry(body)
-                        .or_insert_with(|| Series::new(pvd))
-                        .push(t, &format!("vtu/{file}"))?;
+                    series.entry(body).or_insert_with(|| Series::new(pvd)).push(t, &format!("vtu/{file}"))?;
                 }
                 Ok(())
             });
@@ -166,10 +150,7 @@ pub fn run(
         stepping += ts0.elapsed().as_secs_f64();
         if let Some(b) = &bar {
             let rate = particles * scene.steps() as f64 / stepping.max(1e-9);
-            b.set_message(format!(
-                "t = {:.4}/{tf}  {rate:.3e} particle-steps/s",
-                scene.time()
-            ));
+            b.set_message(format!("t = {:.4}/{tf}  {rate:.3e} particle-steps/s", scene.time()));
         }
         if let Err(d) = res {
             break Outcome::Diverged(d);
@@ -186,17 +167,7 @@ pub fn run(
         Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), BTreeMap::new()),
         Outcome::Failed(r) => (Status::Failed, Some(r.clone()), BTreeMap::new()),
     };
-    let mut s = summary(
-        entry,
-        params,
-        scene.as_ref(),
-        status,
-        reason,
-        metrics,
-        started,
-        t0,
-        stepping,
-    );
+    let mut s = summary(entry, params, scene.as_ref(), status, reason, metrics, started, t0, stepping);
     if let Outcome::Diverged(d) = &outcome {
         s.step = Some(d.step);
         s.final_time = d.time;
@@ -254,15 +225,10 @@ fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
     if quiet || !std::io::stderr().is_terminal() {
         return None;
     }
-    let bar = indicatif::ProgressBar::with_draw_target(
-        Some(1000),
-        indicatif::ProgressDrawTarget::stderr(),
-    );
+    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
     bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{spinner} [{elapsed_precise}] {wide_bar} {msg}  eta {eta}",
-        )
-        .expect("valid template"),
+        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}  eta {eta}")
+            .expect("valid template"),
     );
     Some(bar)
 }
@@ -275,10 +241,7 @@ struct ProgressFile {
 
 impl ProgressFile {
     fn new(path: Option<PathBuf>) -> Self {
-        Self {
-            path,
-            last: Instant::now(),
-        }
+        Self { path, last: Instant::now() }
     }
 
     fn update(&mut self, time: f64, tf: f64, steps: u64) {

@@ -67,12 +67,9 @@ impl SceneEntry {
         let specs = (self.params)();
         let mut p = Params::defaults(&specs);
         for s in sets {
-            let (k, v) = s.split_once('=').ok_or_else(|| {
-                format!(
-                    "scene `{}`: `--set {s}` is not of the form key=value",
-                    self.name
-                )
-            })?;
+            let (k, v) = s
+                .split_once('=')
+                .ok_or_else(|| format!("scene `{}`: `--set {s}` is not of the form key=value", self.name))?;
             p.set_str(self.name, &specs, k.trim(), v)?;
         }
         Ok(p)
@@ -90,17 +87,7 @@ pub fn common_params(tf: f64) -> Vec<Spec> {
             Bound::NonNegative,
             "interval between ParaView snapshots (s); 0: tf/10",
         ),
-        Spec::float(
-            "sample_dt",
-            0.0,
-            Bound::NonNegative,
-            "interval between time-series rows (s); 0: tf/100",
-        ),
-        Spec::float(
-            "cfl",
-            0.25,
-            Bound::Positive,
-            "factor of the time-step limits, CTVF eq. (61)",
-        ),
+        Spec::float("sample_dt", 0.0, Bound::NonNegative, "interval between time-series rows (s); 0: tf/100"),
+        Spec::float("cfl", 0.25, Bound::Positive, "factor of the time-step limits, CTVF eq. (61)"),
     ]
 }

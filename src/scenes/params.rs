@@ -77,30 +77,15 @@ pub struct Spec {
 impl Spec {
     /// An integer parameter.
     pub fn int(name: &'static str, default: i64, min: i64, help: &'static str) -> Self {
-        Self {
-            name,
-            kind: Kind::Int { min },
-            default: Value::Int(default),
-            help,
-        }
+        Self { name, kind: Kind::Int { min }, default: Value::Int(default), help }
     }
     /// A float parameter.
     pub fn float(name: &'static str, default: f64, bound: Bound, help: &'static str) -> Self {
-        Self {
-            name,
-            kind: Kind::Float { bound },
-            default: Value::Float(default),
-            help,
-        }
+        Self { name, kind: Kind::Float { bound }, default: Value::Float(default), help }
     }
     /// A boolean parameter.
     pub fn bool(name: &'static str, default: bool, help: &'static str) -> Self {
-        Self {
-            name,
-            kind: Kind::Bool,
-            default: Value::Bool(default),
-            help,
-        }
+        Self { name, kind: Kind::Bool, default: Value::Bool(default), help }
     }
     /// A choice parameter.
     pub fn choice(
@@ -109,24 +94,15 @@ impl Spec {
         default: &str,
         help: &'static str,
     ) -> Self {
-        Self {
-            name,
-            kind: Kind::Choice(choices),
-            default: Value::Str(default.into()),
-            help,
-        }
+        Self { name, kind: Kind::Choice(choices), default: Value::Str(default.into()), help }
     }
 
     /// The kind in words, for help and errors.
     pub fn kind_name(&self) -> String {
         match self.kind {
             Kind::Int { min } => format!("integer >= {min}"),
-            Kind::Float {
-                bound: Bound::Positive,
-            } => "number > 0".into(),
-            Kind::Float {
-                bound: Bound::NonNegative,
-            } => "number >= 0".into(),
+            Kind::Float { bound: Bound::Positive } => "number > 0".into(),
+            Kind::Float { bound: Bound::NonNegative } => "number >= 0".into(),
             Kind::Float { bound: Bound::None } => "number".into(),
             Kind::Bool => "true|false".into(),
             Kind::Choice(c) => c.join("|"),
@@ -171,14 +147,8 @@ impl Spec {
     pub fn parse(&self, scene: &str, s: &str) -> Result<Value, String> {
         let s = s.trim();
         let v = match self.kind {
-            Kind::Int { .. } => s
-                .parse::<i64>()
-                .map(Value::Int)
-                .unwrap_or_else(|_| Value::Str(s.into())),
-            Kind::Float { .. } => s
-                .parse::<f64>()
-                .map(Value::Float)
-                .unwrap_or_else(|_| Value::Str(s.into())),
+            Kind::Int { .. } => s.parse::<i64>().map(Value::Int).unwrap_or_else(|_| Value::Str(s.into())),
+            Kind::Float { .. } => s.parse::<f64>().map(Value::Float).unwrap_or_else(|_| Value::Str(s.into())),
             Kind::Bool => match s {
                 "true" => Value::Bool(true),
                 "false" => Value::Bool(false),
@@ -197,44 +167,25 @@ pub struct Params(pub BTreeMap<String, Value>);
 impl Params {
     /// All defaults of `specs`.
     pub fn defaults(specs: &[Spec]) -> Self {
-        Self(
-            specs
-                .iter()
-                .map(|s| (s.name.to_string(), s.default.clone()))
-                .collect(),
-        )
+        Self(specs.iter().map(|s| (s.name.to_string(), s.default.clone())).collect())
     }
 
     /// Sets `key` from a string, checked against `specs`.
-    pub fn set_str(
-        &mut self,
-        scene: &str,
-        specs: &[Spec],
-        key: &str,
-        value: &str,
-    ) -> Result<(), String> {
+    pub fn set_str(&mut self, scene: &str, specs: &[Spec], key: &str, value: &str) -> Result<(), String> {
         let spec = find_spec(scene, specs, key, value)?;
         self.0.insert(key.into(), spec.parse(scene, value)?);
         Ok(())
     }
 
     /// Sets `key` from a typed value, checked against `specs`.
-    pub fn set_value(
-        &mut self,
-        scene: &str,
-        specs: &[Spec],
-        key: &str,
-        value: &Value,
-    ) -> Result<(), String> {
+    pub fn set_value(&mut self, scene: &str, specs: &[Spec], key: &str, value: &Value) -> Result<(), String> {
         let spec = find_spec(scene, specs, key, &value.to_string())?;
         self.0.insert(key.into(), spec.check(scene, value)?);
         Ok(())
     }
 
     fn get(&self, key: &str) -> &Value {
-        self.0
-            .get(key)
-            .unwrap_or_else(|| panic!("parameter `{key}` is not declared by this scene"))
+        self.0.get(key).unwrap_or_else(|| panic!("parameter `{key}` is not declared by this scene"))
     }
 
     /// An integer parameter.
@@ -272,24 +223,11 @@ impl Params {
 
     /// As a JSON object (for `summary.json`).
     pub fn to_json(&self) -> BTreeMap<String, serde_json::Value> {
-        self.0
-            .iter()
-            .map(|(k, v)| {
-                (
-                    k.clone(),
-                    serde_json::to_value(v).expect("value serialises"),
-                )
-            })
-            .collect()
+        self.0.iter().map(|(k, v)| (k.clone(), serde_json::to_value(v).expect("value serialises"))).collect()
     }
 }
 
-fn find_spec<'a>(
-    scene: &str,
-    specs: &'a [Spec],
-    key: &str,
-    value: &str,
-) -> Result<&'a Spec, String> {
+fn find_spec<'a>(scene: &str, specs: &'a [Spec], key: &str, value: &str) -> Result<&'a Spec, String> {
     specs.iter().find(|s| s.name == key).ok_or_else(|| {
         let known: Vec<_> = specs.iter().map(|s| s.name).collect();
         format!(
@@ -319,10 +257,7 @@ mod tests {
         let e = p.set_str("tg", &s, "nx", "-5").unwrap_err();
         assert!(e.contains("`nx`") && e.contains("-5"), "{e}");
         let e = p.set_str("tg", &s, "nx", "fifty").unwrap_err();
-        assert!(
-            e.contains("`nx`") && e.contains("fifty") && e.contains("integer"),
-            "{e}"
-        );
+        assert!(e.contains("`nx`") && e.contains("fifty") && e.contains("integer"), "{e}");
         let e = p.set_str("tg", &s, "tf", "0").unwrap_err();
         assert!(e.contains("`tf`") && e.contains("> 0"), "{e}");
         let e = p.set_str("tg", &s, "frobnicate", "3").unwrap_err();

@@ -36,8 +36,7 @@ const C0: f64 = 10.0 * U;
 pub const ENTRY: SceneEntry = SceneEntry {
     name: "taylor_green",
     dim: 2,
-    about:
-        "Taylor-Green vortex in a periodic unit square, against the exact solution (CTVF sec. 4.1)",
+    about: "Taylor-Green vortex in a periodic unit square, against the exact solution (CTVF sec. 4.1)",
     params,
     build,
     metrics: &[
@@ -56,25 +55,10 @@ fn params() -> Vec<Spec> {
         Spec::int("nx", 50, 1, "particles per side"),
         Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
         Spec::choice("scheme", SchemeName::NAMES, "ctvf", "fluid scheme"),
-        Spec::choice(
-            "pst",
-            Pst::NAMES,
-            "sun",
-            "particle shifting for ctvf: Sun 2019, IPST or none",
-        ),
-        Spec::choice(
-            "kernel",
-            KernelKind::NAMES,
-            "quintic_spline",
-            "smoothing kernel",
-        ),
+        Spec::choice("pst", Pst::NAMES, "sun", "particle shifting for ctvf: Sun 2019, IPST or none"),
+        Spec::choice("kernel", KernelKind::NAMES, "quintic_spline", "smoothing kernel"),
         Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
-        Spec::choice(
-            "corrections",
-            &["all", "none"],
-            "all",
-            "the CTVF correction terms, together",
-        ),
+        Spec::choice("corrections", &["all", "none"], "all", "the CTVF correction terms, together"),
         Spec::choice(
             "corr_continuity",
             SWITCH,
@@ -93,19 +77,9 @@ fn params() -> Vec<Spec> {
             "auto",
             "the -u div(u~ - u) term of eq. (19); auto follows `corrections`",
         ),
-        Spec::float(
-            "perturb",
-            0.0,
-            Bound::NonNegative,
-            "random initial displacement, as a fraction of dx",
-        ),
+        Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx"),
         Spec::int("seed", 1, 0, "seed of the initial perturbation"),
-        Spec::float(
-            "edac_alpha",
-            0.5,
-            Bound::Positive,
-            "alpha of nu_edac, eq. (24)",
-        ),
+        Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
         Spec::float(
             "ipst_tol",
             0.02,
@@ -145,11 +119,7 @@ struct TaylorGreen {
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let sim = simulation(p)?;
-    Ok(Box::new(TaylorGreen {
-        sim,
-        re: p.float("re"),
-        l1_max: 0.0,
-    }))
+    Ok(Box::new(TaylorGreen { sim, re: p.float("re"), l1_max: 0.0 }))
 }
 
 /// The simulation the scene runs, for benchmarks and tests that drive steps directly.
@@ -210,12 +180,7 @@ pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
         }
     }
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let time = TimeSettings {
-        cfl: p.float("cfl"),
-        c0: C0,
-        u_ref: U,
-        blowup_factor: 10.0,
-    };
+    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
     Simulation::new(domain, kernel, fluid, scheme, time, false)
         .map_err(|e| format!("scene `taylor_green`: {e}"))
 }
@@ -261,11 +226,8 @@ impl TaylorGreen {
         }
         p_mean /= n;
         pe_mean /= n;
-        let p_err: f64 = pe
-            .iter()
-            .map(|&(k, pex)| ((f.p[k] - p_mean) - (pex - pe_mean)).abs())
-            .sum::<f64>()
-            / n;
+        let p_err: f64 =
+            pe.iter().map(|&(k, pex)| ((f.p[k] - p_mean) - (pex - pe_mean)).abs()).sum::<f64>() / n;
         let b = -8.0 * PI * PI / self.re;
         Errors {
             u_max,
@@ -282,11 +244,7 @@ impl TaylorGreen {
     /// Largest |u~ - u|: how fast the shifting moves particles relative to the flow.
     fn shift_max(&self) -> f64 {
         let f = self.sim.fluid();
-        f.u_hat()
-            .iter()
-            .zip(&f.u)
-            .map(|(a, b)| (a - b).norm())
-            .fold(0.0, f64::max)
+        f.u_hat().iter().zip(&f.u).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max)
     }
 }
 
@@ -320,10 +278,7 @@ impl SceneRun for TaylorGreen {
             ("u_max", e.u_max),
             ("u_max_exact", e.u_max_exact),
             ("l1_velocity", e.l1),
-            (
-                "decay_rel_error",
-                (e.u_max - e.u_max_exact).abs() / e.u_max_exact,
-            ),
+            ("decay_rel_error", (e.u_max - e.u_max_exact).abs() / e.u_max_exact),
             ("p_l1", e.p_l1),
             ("kinetic_energy", e.ke),
             ("kinetic_energy_exact", e.ke_exact),
@@ -358,15 +313,9 @@ impl SceneRun for TaylorGreen {
         let mut m = BTreeMap::new();
         m.insert("l1_velocity_final".into(), e.l1);
         m.insert("l1_velocity_max".into(), self.l1_max.max(e.l1));
-        m.insert(
-            "umax_decay_rel_error".into(),
-            (e.u_max - e.u_max_exact).abs() / e.u_max_exact,
-        );
+        m.insert("umax_decay_rel_error".into(), (e.u_max - e.u_max_exact).abs() / e.u_max_exact);
         m.insert("p_l1_final".into(), e.p_l1);
-        m.insert(
-            "kinetic_energy_rel_error".into(),
-            (e.ke - e.ke_exact).abs() / e.ke_exact,
-        );
+        m.insert("kinetic_energy_rel_error".into(), (e.ke - e.ke_exact).abs() / e.ke_exact);
         m
     }
 }

@@ -31,11 +31,7 @@ pub fn transport_velocity<const D: usize>(
     dt: f64,
 ) {
     let half = 0.5 * dt;
-    u_hat
-        .par_iter_mut()
-        .zip(u)
-        .zip(a_c)
-        .for_each(|((uh, u), ac)| *uh = u + ac * half);
+    u_hat.par_iter_mut().zip(u).zip(a_c).for_each(|((uh, u), ac)| *uh = u + ac * half);
 }
 
 /// Drift, eq. (59): `x += dt u~`.
@@ -50,15 +46,9 @@ mod tests {
     #[test]
     fn time_step_takes_the_smallest_limit() {
         // Acoustic: 0.25 * 0.02 / 11.
-        assert_eq!(
-            time_step(0.25, 0.02, 10.0, 1.0, Some(0.01), 0.0),
-            0.25 * 0.02 / 11.0
-        );
+        assert_eq!(time_step(0.25, 0.02, 10.0, 1.0, Some(0.01), 0.0), 0.25 * 0.02 / 11.0);
         // Viscous: h^2/nu = 4e-4/1 smaller than 0.02/11.
-        assert_eq!(
-            time_step(0.25, 0.02, 10.0, 1.0, Some(1.0), 0.0),
-            0.25 * 0.02 * 0.02
-        );
+        assert_eq!(time_step(0.25, 0.02, 10.0, 1.0, Some(1.0), 0.0), 0.25 * 0.02 * 0.02);
         // Body force: sqrt(h/g).
         let dt = time_step(0.25, 0.02, 0.1, 0.0, None, 9.81);
         assert!((dt - 0.25 * (0.02f64 / 9.81).sqrt()).abs() < 1e-12 * dt);

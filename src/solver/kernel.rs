@@ -24,8 +24,7 @@ pub enum KernelKind {
 
 impl KernelKind {
     /// Names accepted on the command line, in the order of the enum.
-    pub const NAMES: &'static [&'static str] =
-        &["cubic_spline", "quintic_spline", "wendland_c2", "gaussian"];
+    pub const NAMES: &'static [&'static str] = &["cubic_spline", "quintic_spline", "wendland_c2", "gaussian"];
 
     /// Parses a kernel name as written in `NAMES`.
     pub fn from_name(name: &str) -> Option<Self> {
@@ -55,10 +54,7 @@ pub struct Kernel {
 impl Kernel {
     /// The kernel `kind` normalised in `dim` dimensions (1, 2 or 3).
     pub fn new(kind: KernelKind, dim: usize) -> Self {
-        assert!(
-            (1..=3).contains(&dim),
-            "kernels are defined for 1, 2 and 3 dimensions"
-        );
+        assert!((1..=3).contains(&dim), "kernels are defined for 1, 2 and 3 dimensions");
         let sigma = match (kind, dim) {
             (KernelKind::CubicSpline, 1) => 2.0 / 3.0,
             (KernelKind::CubicSpline, 2) => 10.0 / (7.0 * PI),
@@ -71,11 +67,7 @@ impl Kernel {
             (KernelKind::WendlandC2, _) => 21.0 / (16.0 * PI),
             (KernelKind::Gaussian, d) => 1.0 / PI.powf(d as f64 / 2.0),
         };
-        Self {
-            kind,
-            sigma,
-            dim: dim as i32,
-        }
+        Self { kind, sigma, dim: dim as i32 }
     }
 
     /// Which kernel this is.
@@ -91,61 +83,32 @@ impl Kernel {
         }
     }
 
-    /// `w(q)` and `dw/dq` of the unnormalised kernel.
+    /// `w(q)` and `dw/dq` of the unnormalised kernel. Written without branches on `q`
+    /// (clamped polynomial pieces): neighbours sit at all distances, so a branch per piece
+    /// would be mispredicted in the pair loops.
     #[inline(always)]
     fn shape(&self, q: f64) -> (f64, f64) {
         match self.kind {
             KernelKind::CubicSpline => {
-                if q < 1.0 {
-                    (
-                        1.0 - 1.5 * q * q + 0.75 * q * q * q,
-                        -3.0 * q + 2.25 * q * q,
-                    )
-                } else if q < 2.0 {
-                    let t = 2.0 - q;
-                    (0.25 * t * t * t, -0.75 * t * t)
-                } else {
-                    (0.0, 0.0)
-                }
+                let t2 = (2.0 - q).max(0.0);
+                let t1 = (1.0 - q).max(0.0);
+                (0.25 * t2 * t2 * t2 - t1 * t1 * t1, -0.75 * t2 * t2 + 3.0 * t1 * t1)
             }
             KernelKind::QuinticSpline => {
-                let (mut w, mut dw) = (0.0, 0.0);
-                if q < 3.0 {
-                    let t = 3.0 - q;
-                    let t4 = t * t * t * t;
-                    w += t4 * t;
-                    dw -= 5.0 * t4;
-                }
-                if q < 2.0 {
-                    let t = 2.0 - q;
-                    let t4 = t * t * t * t;
-                    w -= 6.0 * t4 * t;
-                    dw += 30.0 * t4;
-                }
-                if q < 1.0 {
-                    let t = 1.0 - q;
-                    let t4 = t * t * t * t;
-                    w += 15.0 * t4 * t;
-                    dw -= 75.0 * t4;
-                }
-                (w, dw)
+                let t3 = (3.0 - q).max(0.0);
+                let t2 = (2.0 - q).max(0.0);
+                let t1 = (1.0 - q).max(0.0);
+                let (t3_4, t2_4, t1_4) = (t3 * t3 * t3 * t3, t2 * t2 * t2 * t2, t1 * t1 * t1 * t1);
+                (t3_4 * t3 - 6.0 * t2_4 * t2 + 15.0 * t1_4 * t1, -5.0 * t3_4 + 30.0 * t2_4 - 75.0 * t1_4)
             }
             KernelKind::WendlandC2 => {
-                if q < 2.0 {
-                    let t = 1.0 - 0.5 * q;
-                    let t3 = t * t * t;
-                    (t3 * t * (2.0 * q + 1.0), -5.0 * q * t3)
-                } else {
-                    (0.0, 0.0)
-                }
+                let t = (1.0 - 0.5 * q).max(0.0);
+                let t3 = t * t * t;
+                (t3 * t * (2.0 * q + 1.0), -5.0 * q * t3)
             }
             KernelKind::Gaussian => {
-                if q < 3.0 {
-                    let e = (-q * q).exp();
-                    (e, -2.0 * q * e)
-                } else {
-                    (0.0, 0.0)
-                }
+                let e = if q < 3.0 { (-q * q).exp() } else { 0.0 };
+                (e, -2.0 * q * e)
             }
         }
     }
@@ -154,6 +117,12 @@ impl Kernel {
     #[inline(always)]
     fn inv_hd(&self, h: f64) -> f64 {
         1.0 / h.powi(self.dim)
+    }
+
+    /// This kernel at a fixed smoothing length, with `sigma / h^D` and `1/h` precomputed
+    /// for the pair loops.
+    pub fn scaled(&self, h: f64) -> ScaledKernel {
+        ScaledKernel { kernel: *self, h, inv_h: 1.0 / h, fac: self.sigma * self.inv_hd(h) }
     }
 
     /// W(r, h).
@@ -184,16 +153,38 @@ impl Kernel {
     }
 }
 
+/// A [`Kernel`] at one smoothing length (bodies have a uniform h).
+#[derive(Clone, Copy, Debug)]
+pub struct ScaledKernel {
+    kernel: Kernel,
+    /// Smoothing length.
+    pub h: f64,
+    inv_h: f64,
+    fac: f64,
+}
+
+impl ScaledKernel {
+    /// W(r).
+    #[inline(always)]
+    pub fn w(&self, r: f64) -> f64 {
+        self.fac * self.kernel.shape(r * self.inv_h).0
+    }
+
+    /// W(r) and (1/r) dW/dr (0 at r = 0), the factor that turns `x_ab` into `grad_a W_ab`.
+    #[inline(always)]
+    pub fn w_and_grad_factor(&self, r: f64) -> (f64, f64) {
+        let (w, dw) = self.kernel.shape(r * self.inv_h);
+        let g = if r > 1e-12 * self.h { self.fac * dw * self.inv_h / r } else { 0.0 };
+        (self.fac * w, g)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    const ALL: [KernelKind; 4] = [
-        KernelKind::CubicSpline,
-        KernelKind::QuinticSpline,
-        KernelKind::WendlandC2,
-        KernelKind::Gaussian,
-    ];
+    const ALL: [KernelKind; 4] =
+        [KernelKind::CubicSpline, KernelKind::QuinticSpline, KernelKind::WendlandC2, KernelKind::Gaussian];
 
     /// Sum of W over a lattice of spacing dx around the origin, times the cell volume.
     fn lattice_integral(k: &Kernel, dim: usize, h: f64, dx: f64) -> f64 {
@@ -224,15 +215,8 @@ mod tests {
                 let k = Kernel::new(kind, dim);
                 let h = 1.0;
                 let integral = lattice_integral(&k, dim, h, h / 8.0);
-                let tol = if kind == KernelKind::Gaussian {
-                    2e-3
-                } else {
-                    1e-3
-                };
-                assert!(
-                    (integral - 1.0).abs() < tol,
-                    "{kind:?} in {dim}D integrates to {integral}"
-                );
+                let tol = if kind == KernelKind::Gaussian { 2e-3 } else { 1e-3 };
+                assert!((integral - 1.0).abs() < tol, "{kind:?} in {dim}D integrates to {integral}");
             }
         }
     }
@@ -249,10 +233,7 @@ mod tests {
                     let fd = (k.w(r + eps, h) - k.w(r - eps, h)) / (2.0 * eps);
                     let (_, dw) = k.w_dwdr(r, h);
                     let scale = k.w(0.0, h) / h;
-                    assert!(
-                        (fd - dw).abs() < 1e-6 * scale,
-                        "{kind:?} {dim}D r={r}: fd {fd} analytic {dw}"
-                    );
+                    assert!((fd - dw).abs() < 1e-6 * scale, "{kind:?} {dim}D r={r}: fd {fd} analytic {dw}");
                     r += 0.013;
                 }
             }
@@ -271,6 +252,22 @@ mod tests {
                     assert_eq!(k.w_dwdr(r, h).1, 0.0, "{kind:?} dW({r})");
                 }
                 assert!(k.w(0.99 * rs, h) >= 0.0);
+            }
+        }
+    }
+
+    #[test]
+    fn scaled_kernel_equals_kernel() {
+        for kind in ALL {
+            let k = Kernel::new(kind, 2);
+            let s = k.scaled(0.37);
+            for r in [0.0, 0.1, 0.4, 0.9, 1.2] {
+                assert!((s.w(r) - k.w(r, 0.37)).abs() <= 1e-14 * k.w(0.0, 0.37));
+                let (a, b) = (s.w_and_grad_factor(r), k.w_and_grad_factor(r, 0.37));
+                assert!(
+                    (a.0 - b.0).abs() <= 1e-14 * k.w(0.0, 0.37)
+                        && (a.1 - b.1).abs() <= 1e-12 * b.1.abs().max(1.0)
+                );
             }
         }
     }

@@ -6,7 +6,8 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::scheme::{
-    ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, PressureModel, Shifting,
+    build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
+    Shifting,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -64,6 +65,7 @@ pub struct Simulation<const D: usize> {
     /// Everything that evolves.
     pub state: State<D>,
     cells: CellList<D>,
+    neighbours: KernelList<D>,
     passes: FluidPasses<D>,
 }
 
@@ -96,40 +98,26 @@ impl<const D: usize> Simulation<D> {
             scheme.density == DensityModel::Continuity,
             transport,
         );
-        let mut state = State {
-            fluid,
-            rates,
-            time: 0.0,
-            steps: 0,
-            u_max: 0.0,
-            scheme,
-        };
-        Self::rebuild(&domain, &mut cells, &mut state.fluid);
+        let mut state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme };
+        let mut neighbours = KernelList::new();
+        Self::rebuild(&domain, &kernel, &mut cells, &mut neighbours, &mut state.fluid);
         if let Some(t) = scheme.transport.as_mut() {
             if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
-                *chi_ref = ipst_chi_reference(&state.fluid, &cells, &kernel, free_surface);
+                *chi_ref = ipst_chi_reference(&state.fluid, &neighbours, free_surface);
             }
         }
         state.scheme = scheme;
-        let passes = FluidPasses::new(&scheme, domain, radius);
-        let mut sim = Self {
-            domain,
-            kernel,
-            time_settings,
-            state,
-            cells,
-            passes,
-        };
+        let passes = FluidPasses::new();
+        let mut sim = Self { domain, kernel, time_settings, state, cells, neighbours, passes };
         sim.state.u_max = sim.max_speed();
         // Initial accelerations for the first half kick; the pressure is the initial one.
         if sim.state.scheme.density == DensityModel::Summation {
-            FluidPasses::summation_density(&mut sim.state.fluid, &sim.cells, &sim.kernel);
+            FluidPasses::summation_density(&mut sim.state.fluid, &sim.neighbours);
         }
         if let PressureModel::StateEquation { .. } = sim.state.scheme.pressure {
-            FluidPasses::update_density_and_pressure(
+            sim.passes.update_density_and_pressure(
                 &mut sim.state.fluid,
-                &sim.cells,
-                &sim.kernel,
+                &sim.neighbours,
                 &sim.state.scheme,
                 &mut sim.state.rates,
                 0.0,
@@ -142,24 +130,14 @@ impl<const D: usize> Simulation<D> {
 
     /// Resumes from a checkpointed state (the cell list is rebuilt from the positions,
     /// which are already in cell order, so the neighbour order is the same).
-    pub fn resume(
-        domain: Domain<D>,
-        kernel: Kernel,
-        time_settings: TimeSettings,
-        state: State<D>,
-    ) -> Self {
+    pub fn resume(domain: Domain<D>, kernel: Kernel, time_settings: TimeSettings, state: State<D>) -> Self {
         let radius = kernel.support() * state.fluid.h;
         let mut cells = CellList::new(domain, radius);
         cells.update(&state.fluid.x);
-        let passes = FluidPasses::new(&state.scheme, domain, radius);
-        Self {
-            domain,
-            kernel,
-            time_settings,
-            state,
-            cells,
-            passes,
-        }
+        let mut neighbours = KernelList::new();
+        build_kernel_list(&mut neighbours, &cells, &state.fluid, &kernel);
+        let passes = FluidPasses::new();
+        Self { domain, kernel, time_settings, state, cells, neighbours, passes }
     }
 
     /// The fluid body.
@@ -182,11 +160,19 @@ impl<const D: usize> Simulation<D> {
         self.passes.last_ipst_iterations
     }
 
-    fn rebuild(domain: &Domain<D>, cells: &mut CellList<D>, fluid: &mut Fluid<D>) {
+    /// Wraps positions into the box, sorts the particles by cell and lists neighbours.
+    fn rebuild(
+        domain: &Domain<D>,
+        kernel: &Kernel,
+        cells: &mut CellList<D>,
+        nl: &mut KernelList<D>,
+        fluid: &mut Fluid<D>,
+    ) {
         fluid.x.par_iter_mut().for_each(|x| domain.wrap(x));
         cells.update(&fluid.x);
         fluid.reorder(cells.order());
         cells.mark_reordered();
+        build_kernel_list(nl, cells, fluid, kernel);
     }
 
     /// The time step of eq. (61) from the current largest speed.
@@ -206,22 +192,8 @@ impl<const D: usize> Simulation<D> {
 
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
         let st = &mut self.state;
-        FluidPasses::accelerations(
-            &st.fluid,
-            &self.cells,
-            &self.kernel,
-            &st.scheme,
-            &mut st.rates,
-            dt_nominal,
-        );
-        self.passes.ipst(
-            &st.fluid,
-            &self.domain,
-            &self.kernel,
-            &st.scheme,
-            &mut st.rates,
-            dt_nominal,
-        );
+        self.passes.accelerations(&st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt_nominal);
+        self.passes.ipst(&st.fluid, &self.neighbours, &self.kernel, &st.scheme, &mut st.rates, dt_nominal);
     }
 
     /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60).
@@ -238,16 +210,21 @@ impl<const D: usize> Simulation<D> {
             let Fluid { x, u, u_hat, .. } = f;
             integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
-        Self::rebuild(&self.domain, &mut self.cells, &mut self.state.fluid);
+        Self::rebuild(
+            &self.domain,
+            &self.kernel,
+            &mut self.cells,
+            &mut self.neighbours,
+            &mut self.state.fluid,
+        );
         {
             let st = &mut self.state;
             if st.scheme.density == DensityModel::Summation {
-                FluidPasses::summation_density(&mut st.fluid, &self.cells, &self.kernel);
+                FluidPasses::summation_density(&mut st.fluid, &self.neighbours);
             }
-            FluidPasses::update_density_and_pressure(
+            self.passes.update_density_and_pressure(
                 &mut st.fluid,
-                &self.cells,
-                &self.kernel,
+                &self.neighbours,
                 &st.scheme,
                 &mut st.rates,
                 dt,
@@ -262,11 +239,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Steps until `t_end` is reached exactly (the last step is shortened).
-    pub fn advance_to(
-        &mut self,
-        t_end: f64,
-        mut on_step: impl FnMut(&Self),
-    ) -> Result<(), Divergence> {
+    pub fn advance_to(&mut self, t_end: f64, mut on_step: impl FnMut(&Self)) -> Result<(), Divergence> {
         loop {
             let remaining = t_end - self.state.time;
             if remaining <= 1e-12 * t_end.abs().max(1.0) {
@@ -279,13 +252,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Largest particle speed.
     pub fn max_speed(&self) -> f64 {
-        self.state
-            .fluid
-            .u
-            .par_iter()
-            .map(|u| u.norm_squared())
-            .reduce(|| 0.0, f64::max)
-            .sqrt()
+        self.state.fluid.u.par_iter().map(|u| u.norm_squared()).reduce(|| 0.0, f64::max).sqrt()
     }
 
     /// Blow-up detection: non-finite fields, speeds beyond the bound, particles outside a
@@ -303,17 +270,10 @@ impl<const D: usize> Simulation<D> {
                     && f.p[i].is_finite()
                     && f.rho[i].is_finite()
                     && domain.contains(&f.x[i]);
-                (
-                    if ok { f.u[i].norm_squared() } else { 0.0 },
-                    if ok { usize::MAX } else { i },
-                )
+                (if ok { f.u[i].norm_squared() } else { 0.0 }, if ok { usize::MAX } else { i })
             })
             .reduce(|| (0.0, usize::MAX), |a, b| (a.0.max(b.0), a.1.min(b.1)));
-        let fail = |reason: String| Divergence {
-            reason,
-            step: self.state.steps,
-            time: self.state.time,
-        };
+        let fail = |reason: String| Divergence { reason, step: self.state.steps, time: self.state.time };
         if bad != usize::MAX {
             let what = if !f.u[bad].iter().all(|v| v.is_finite()) {
                 "velocity is not finite"

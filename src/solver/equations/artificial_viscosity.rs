@@ -1,24 +1,18 @@
 //! Monaghan's artificial viscosity, CTVF eqs. (28)-(29).
 
-use super::{eps2, Pair, Point};
+use super::{Pair, Point};
 use crate::solver::math::Vector;
 
 /// `-m_b Pi_ab grad W` with `Pi_ab = -alpha h_ab c_ab phi_ab / rho_ab` for approaching
 /// particles (`u_ab . x_ab < 0`) and 0 otherwise, `phi_ab = u_ab . x_ab / (r^2 + 0.01 h^2)`
 /// (eq. 29); `c` is the (uniform) speed of sound.
 #[inline(always)]
-pub fn monaghan<const D: usize>(
-    a: &Point<D>,
-    b: &Point<D>,
-    ab: &Pair<D>,
-    alpha: f64,
-    c: f64,
-) -> Vector<D> {
+pub fn monaghan<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, alpha: f64, c: f64) -> Vector<D> {
     let vr = (a.u - b.u).dot(&ab.xij);
     if vr >= 0.0 {
         return Vector::zeros();
     }
-    let phi = vr / (ab.r2 + eps2(ab.h));
+    let phi = vr * ab.inv_r2_eps;
     let pi_ab = -alpha * ab.h * c * phi / (0.5 * (a.rho + b.rho));
     ab.dwij * (-b.m * pi_ab)
 }

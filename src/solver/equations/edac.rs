@@ -1,7 +1,7 @@
 //! EDAC pressure evolution (Ramachandran & Puri 2019) with the transport-velocity terms of
 //! CTVF eqs. (23), (24) and (26).
 
-use super::{eps2, Pair, Point};
+use super::{Pair, Point};
 
 /// `nu_edac = alpha h c_s / 8`, eq. (24); alpha = 0.5 is the paper's value.
 pub fn nu_edac(alpha: f64, h: f64, cs: f64) -> f64 {
@@ -37,7 +37,7 @@ pub fn transport_correction<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pai
 /// is what PySPH's `EDACEquation` computes. We use 2.
 #[inline(always)]
 pub fn diffusion<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, nu: f64) -> f64 {
-    b.v() * 2.0 * nu * (a.p - b.p) * ab.xij.dot(&ab.dwij) / (ab.r2 + eps2(ab.h))
+    b.v() * 2.0 * nu * (a.p - b.p) * ab.xij.dot(&ab.dwij) * ab.inv_r2_eps
 }
 
 #[cfg(test)]

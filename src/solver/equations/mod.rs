@@ -28,9 +28,21 @@ pub struct Pair<const D: usize> {
     pub wij: f64,
     /// grad_a W_ab.
     pub dwij: Vector<D>,
+    /// 1 / (r^2 + 0.01 h^2), the regularised inverse distance of eqs. (26), (27), (29).
+    pub inv_r2_eps: f64,
 }
 
-/// The values of one particle a term may read, gathered once per particle.
+impl<const D: usize> Pair<D> {
+    /// The pair at difference `xij` (with `r2 = |xij|^2`), kernel value `wij` and gradient
+    /// factor `(1/r) dW/dr`.
+    #[inline(always)]
+    pub fn new(xij: Vector<D>, r2: f64, h: f64, wij: f64, grad_factor: f64) -> Self {
+        Self { xij, r2, h, wij, dwij: xij * grad_factor, inv_r2_eps: 1.0 / (r2 + eps2(h)) }
+    }
+}
+
+/// The values of one particle a term may read, gathered once per particle and pass, with
+/// the quotients every pair would otherwise recompute.
 #[derive(Clone, Copy, Debug)]
 pub struct Point<const D: usize> {
     /// Momentum velocity u.
@@ -43,13 +55,25 @@ pub struct Point<const D: usize> {
     pub rho: f64,
     /// Pressure.
     pub p: f64,
+    /// Volume m / rho.
+    pub vol: f64,
+    /// 1 / rho^2.
+    pub inv_rho2: f64,
+    /// 1 / m.
+    pub inv_m: f64,
 }
 
 impl<const D: usize> Point<D> {
+    /// A particle's view from its fields.
+    #[inline(always)]
+    pub fn new(u: Vector<D>, u_hat: Vector<D>, m: f64, rho: f64, p: f64) -> Self {
+        Self { u, u_hat, m, rho, p, vol: m / rho, inv_rho2: 1.0 / (rho * rho), inv_m: 1.0 / m }
+    }
+
     /// Volume m / rho.
     #[inline(always)]
     pub fn v(&self) -> f64 {
-        self.m / self.rho
+        self.vol
     }
 
     /// u~ - u.
@@ -72,13 +96,7 @@ pub(crate) mod test_support {
     use crate::solver::kernel::{Kernel, KernelKind};
 
     pub fn point(u: [f64; 2], u_hat: [f64; 2], m: f64, rho: f64, p: f64) -> Point<2> {
-        Point {
-            u: Vector::<2>::from(u),
-            u_hat: Vector::<2>::from(u_hat),
-            m,
-            rho,
-            p,
-        }
+        Point::new(Vector::<2>::from(u), Vector::<2>::from(u_hat), m, rho, p)
     }
 
     /// The pair (a, b) and the reversed pair (b, a) for positions xa, xb.
@@ -87,13 +105,7 @@ pub(crate) mod test_support {
         let make = |xij: Vector<2>| {
             let r2 = xij.norm_squared();
             let (w, f) = k.w_and_grad_factor(r2.sqrt(), h);
-            Pair {
-                xij,
-                r2,
-                h,
-                wij: w,
-                dwij: xij * f,
-            }
+            Pair::new(xij, r2, h, w, f)
         };
         let xab = Vector::<2>::from(xa) - Vector::<2>::from(xb);
         (make(xab), make(-xab))

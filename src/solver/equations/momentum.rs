@@ -7,18 +7,14 @@ use crate::solver::math::Vector;
 /// `-grad(p)/rho` in the symmetric form of eq. (27): `-m_b (p_a/rho_a^2 + p_b/rho_b^2) grad W`.
 #[inline(always)]
 pub fn pressure_gradient<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
-    ab.dwij * (-b.m * (a.p / (a.rho * a.rho) + b.p / (b.rho * b.rho)))
+    ab.dwij * (-b.m * (a.p * a.inv_rho2 + b.p * b.inv_rho2))
 }
 
 /// What [`pressure_gradient`] gains per unit of a reference pressure subtracted from both
 /// `p_a` and `p_b`: `m_b (1/rho_a^2 + 1/rho_b^2) grad W`.
 #[inline(always)]
-pub fn pressure_reference_weight<const D: usize>(
-    a: &Point<D>,
-    b: &Point<D>,
-    ab: &Pair<D>,
-) -> Vector<D> {
-    ab.dwij * (b.m * (1.0 / (a.rho * a.rho) + 1.0 / (b.rho * b.rho)))
+pub fn pressure_reference_weight<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
+    ab.dwij * (b.m * (a.inv_rho2 + b.inv_rho2))
 }
 
 /// The Adami et al. (2013) inter-particle pressure `p~_ab = (rho_b p_a + rho_a p_b) /
@@ -32,17 +28,13 @@ pub fn inter_particle_pressure<const D: usize>(a: &Point<D>, b: &Point<D>) -> f6
 #[inline(always)]
 pub fn adami_weight<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
     let (va, vb) = (a.v(), b.v());
-    ab.dwij * ((va * va + vb * vb) / a.m)
+    ab.dwij * ((va * va + vb * vb) * a.inv_m)
 }
 
 /// The Adami et al. (2013) pressure gradient `-(V_a^2 + V_b^2)/m_a p~_ab grad W`. A reference
 /// pressure subtracted from `p~_ab` adds [`adami_weight`] per unit.
 #[inline(always)]
-pub fn pressure_gradient_adami<const D: usize>(
-    a: &Point<D>,
-    b: &Point<D>,
-    ab: &Pair<D>,
-) -> Vector<D> {
+pub fn pressure_gradient_adami<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
     adami_weight(a, b, ab) * -inter_particle_pressure(a, b)
 }
 
@@ -51,8 +43,8 @@ pub fn pressure_gradient_adami<const D: usize>(
 /// `A = rho u (x) (u~ - u)`, so that `A . grad W = rho u ((u~ - u) . grad W)`.
 #[inline(always)]
 pub fn artificial_stress<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
-    let aa = a.u * (a.du().dot(&ab.dwij) / a.rho);
-    let bb = b.u * (b.du().dot(&ab.dwij) / b.rho);
+    let aa = a.u * (a.du().dot(&ab.dwij) * a.rho * a.inv_rho2);
+    let bb = b.u * (b.du().dot(&ab.dwij) * b.rho * b.inv_rho2);
     (aa + bb) * b.m
 }
 

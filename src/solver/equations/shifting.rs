@@ -8,12 +8,7 @@ use crate::solver::math::Vector;
 /// Adami et al. (2013) background-pressure acceleration (CTVF eq. 20) in the volume form
 /// `-p_b (V_a^2 + V_b^2)/m_a grad W` that PySPH's TVF and EDAC schemes use.
 #[inline(always)]
-pub fn background_pressure<const D: usize>(
-    a: &Point<D>,
-    b: &Point<D>,
-    ab: &Pair<D>,
-    pb: f64,
-) -> Vector<D> {
+pub fn background_pressure<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, pb: f64) -> Vector<D> {
     super::momentum::adami_weight(a, b, ab) * -pb
 }
 
@@ -22,7 +17,18 @@ pub fn background_pressure<const D: usize>(
 /// `-(Ma 2h c_0 / dt)` times the sum over neighbours.
 #[inline(always)]
 pub fn sun2019<const D: usize>(b: &Point<D>, ab: &Pair<D>, w_dx: f64, r: f64, n: i32) -> Vector<D> {
-    ab.dwij * (b.v() * (1.0 + r * (ab.wij / w_dx).powi(n)))
+    ab.dwij * (b.v() * (1.0 + r * powi_small(ab.wij / w_dx, n)))
+}
+
+/// `x^n` for a small non-negative `n` by repeated multiplication (`powi` with a
+/// run-time exponent is a library call in the pair loop).
+#[inline(always)]
+fn powi_small(x: f64, n: i32) -> f64 {
+    let mut p = 1.0;
+    for _ in 0..n {
+        p *= x;
+    }
+    p
 }
 
 /// One IPST displacement contribution, eq. (37) without `U_max dt`: `V_b n_ab W_ab` with

@@ -1,6 +1,6 @@
 //! Physical viscosity.
 
-use super::{eps2, Pair, Point};
+use super::{Pair, Point};
 use crate::solver::math::Vector;
 
 /// Morris et al. (1997) laminar viscosity, the third term of CTVF eq. (27):
@@ -8,7 +8,7 @@ use crate::solver::math::Vector;
 /// kinematic viscosity.
 #[inline(always)]
 pub fn morris<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, nu: f64) -> Vector<D> {
-    let f = b.m * 4.0 * nu * ab.xij.dot(&ab.dwij) / ((a.rho + b.rho) * (ab.r2 + eps2(ab.h)));
+    let f = b.m * 4.0 * nu * ab.xij.dot(&ab.dwij) * ab.inv_r2_eps / (a.rho + b.rho);
     (a.u - b.u) * f
 }
 

@@ -148,15 +148,55 @@ impl<const D: usize> CellList<D> {
         query: &Vector<D>,
         mut f: F,
     ) {
-        // Per axis: the (up to three) neighbour cell coordinates and the shift to apply
-        // to the source positions in them.
+        self.visit(points, query, |j, xij, r2, _| f(j, xij, r2));
+    }
+
+    /// The image shift of a neighbour found through periodic wrap `wraps` (periods per
+    /// axis): the neighbour's image sits at `x_j + shift`.
+    pub fn shift(&self, wraps: [i8; D]) -> Vector<D> {
+        let mut s = Vector::<D>::zeros();
+        for k in 0..D {
+            s[k] = wraps[k] as f64 * self.domain.length(k);
+        }
+        s
+    }
+
+    /// As [`for_each_neighbour`](Self::for_each_neighbour), also passing the number of
+    /// periods each axis was wrapped by to reach the neighbour's image. `x_ij` is computed
+    /// as `(query - shift) - x_j`.
+    #[inline(always)]
+    pub fn visit<F: FnMut(usize, Vector<D>, f64, [i8; D])>(
+        &self,
+        points: &[Vector<D>],
+        query: &Vector<D>,
+        mut f: F,
+    ) {
+        let r2max = self.radius2;
+        self.for_each_candidate_cell(query, |candidates, q, wraps| {
+            for &j in candidates {
+                let j = j as usize;
+                let xij = q - points[j];
+                let r2 = xij.norm_squared();
+                if r2 < r2max {
+                    f(j, xij, r2, wraps);
+                }
+            }
+        });
+    }
+
+    /// Calls `f(candidates, q, wraps)` for each of the 3^D cells around `query`: the point
+    /// indices binned in the cell, the query moved by the image shift (`query - shift`, so
+    /// that `q - x_j` is the pair difference) and the periods wrapped per axis.
+    #[inline(always)]
+    pub fn for_each_candidate_cell<F: FnMut(&[u32], Vector<D>, [i8; D])>(&self, query: &Vector<D>, mut f: F) {
+        // Per axis: the (up to three) neighbour cell coordinates and the periods wrapped
+        // to reach them.
         let mut cells = [[0usize; 3]; D];
-        let mut shifts = [[0.0f64; 3]; D];
+        let mut wraps = [[0i8; 3]; D];
         let mut counts = [0usize; D];
         for k in 0..D {
             let c = ((query[k] - self.origin[k]) / self.cell_size[k]).floor() as i64;
             let n = self.ncells[k] as i64;
-            let l = self.domain.length(k);
             if self.domain.periodic[k] {
                 for o in -1..=1i64 {
                     // The query may sit slightly outside the box (positions are wrapped
@@ -165,7 +205,7 @@ impl<const D: usize> CellList<D> {
                     // a different image, which is right.
                     let cc = c + o;
                     cells[k][counts[k]] = cc.rem_euclid(n) as usize;
-                    shifts[k][counts[k]] = cc.div_euclid(n) as f64 * l;
+                    wraps[k][counts[k]] = cc.div_euclid(n) as i8;
                     counts[k] += 1;
                 }
             } else {
@@ -183,26 +223,14 @@ impl<const D: usize> CellList<D> {
         let mut pick = [0usize; D];
         loop {
             let mut c = [0usize; D];
-            let mut shift = Vector::<D>::zeros();
+            let mut w = [0i8; D];
             for k in 0..D {
                 c[k] = cells[k][pick[k]];
-                shift[k] = shifts[k][pick[k]];
+                w[k] = wraps[k][pick[k]];
             }
             let cell = self.linear(&c);
-            let (start, end) = (
-                self.cell_start[cell] as usize,
-                self.cell_start[cell + 1] as usize,
-            );
-            let q = query - shift;
-            for &j in &self.sorted[start..end] {
-                let j = j as usize;
-                let xij = q - points[j];
-                let r2 = xij.norm_squared();
-                if r2 < self.radius2 {
-                    f(j, xij, r2);
-                }
-            }
-            // Advance the odometer.
+            let (start, end) = (self.cell_start[cell] as usize, self.cell_start[cell + 1] as usize);
+            f(&self.sorted[start..end], query - self.shift(w), w);
             let mut k = 0;
             loop {
                 if k == D {
@@ -216,6 +244,11 @@ impl<const D: usize> CellList<D> {
                 k += 1;
             }
         }
+    }
+
+    /// Squared search radius.
+    pub fn radius2(&self) -> f64 {
+        self.radius2
     }
 }
 
@@ -241,10 +274,7 @@ mod tests {
                 cl.for_each_neighbour(points, q, |j, xij, r2| {
                     // The reported difference is the minimum image.
                     let d = domain.delta(q, &points[j]);
-                    assert!(
-                        (d - xij).norm() < 1e-12,
-                        "xij {xij:?} vs minimum image {d:?}"
-                    );
+                    assert!((d - xij).norm() < 1e-12, "xij {xij:?} vs minimum image {d:?}");
                     assert!((r2 - d.norm_squared()).abs() < 1e-12);
                     v.push(j)
                 });
@@ -254,11 +284,7 @@ mod tests {
             .collect()
     }
 
-    fn random_points<const D: usize>(
-        rng: &mut ChaCha8Rng,
-        n: usize,
-        d: &Domain<D>,
-    ) -> Vec<Vector<D>> {
+    fn random_points<const D: usize>(rng: &mut ChaCha8Rng, n: usize, d: &Domain<D>) -> Vec<Vector<D>> {
         (0..n)
             .map(|_| {
                 let mut x = Vector::<D>::zeros();
@@ -282,7 +308,11 @@ mod tests {
                 .collect()
         };
         for i in 0..points.len() {
-            assert_eq!(clear(i, &brute[i]), clear(i, &cells[i]), "point {i}, radius {radius}, domain {domain:?}");
+            assert_eq!(
+                clear(i, &brute[i]),
+                clear(i, &cells[i]),
+                "point {i}, radius {radius}, domain {domain:?}"
+            );
         }
         assert!(brute.iter().map(|v| v.len()).sum::<usize>() > points.len(), "test has pairs");
     }
@@ -292,11 +322,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(7);
         for &radius in &[0.05, 0.13, 0.3, 0.45] {
             for periodic in [[true, true], [false, false], [true, false]] {
-                let d = Domain {
-                    min: [0.0, -0.5],
-                    max: [1.0, 0.7],
-                    periodic,
-                };
+                let d = Domain { min: [0.0, -0.5], max: [1.0, 0.7], periodic };
                 let pts = random_points(&mut rng, 400, &d);
                 check(d, radius, pts);
             }
@@ -308,11 +334,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(11);
         for &radius in &[0.1, 0.26, 0.49] {
             for periodic in [[true; 3], [false; 3], [true, false, true]] {
-                let d = Domain {
-                    min: [0.0; 3],
-                    max: [1.0, 1.0, 1.0],
-                    periodic,
-                };
+                let d = Domain { min: [0.0; 3], max: [1.0, 1.0, 1.0], periodic };
                 let pts = random_points(&mut rng, 300, &d);
                 check(d, radius, pts);
             }
@@ -335,11 +357,7 @@ mod tests {
         pts.push(Vector::<2>::new(1.0 - 1e-15, 0.5));
         pts.push(Vector::<2>::new(0.5, 1.0 - f64::EPSILON));
         for radius in [3.0 * dx, 2.0 * dx, 0.1 + 1e-12, 0.3] {
-            check(
-                Domain::periodic([0.0, 0.0], [1.0, 1.0]),
-                radius,
-                pts.clone(),
-            );
+            check(Domain::periodic([0.0, 0.0], [1.0, 1.0]), radius, pts.clone());
             check(Domain::bounded([0.0, 0.0], [1.0, 1.0]), radius, pts.clone());
         }
     }

@@ -11,9 +11,11 @@
 
 mod brute;
 mod cell_list;
+mod neighbour_list;
 
 pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
+pub use neighbour_list::NeighbourList;
 
 use crate::solver::math::Vector;
 
@@ -32,20 +34,12 @@ pub struct Domain<const D: usize> {
 impl<const D: usize> Domain<D> {
     /// A box periodic along every axis.
     pub fn periodic(min: [f64; D], max: [f64; D]) -> Self {
-        Self {
-            min,
-            max,
-            periodic: [true; D],
-        }
+        Self { min, max, periodic: [true; D] }
     }
 
     /// A bounded box (no periodic axis).
     pub fn bounded(min: [f64; D], max: [f64; D]) -> Self {
-        Self {
-            min,
-            max,
-            periodic: [false; D],
-        }
+        Self { min, max, periodic: [false; D] }
     }
 
     /// Edge length along `k`.

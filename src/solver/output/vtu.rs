@@ -28,25 +28,22 @@ pub fn write_vtu(path: &Path, points: &[[f64; 3]], fields: &[Field]) -> std::io:
     for f in fields {
         match f {
             Field::Scalar(name, v) => {
-                let _ = writeln!(
-                    s,
-                    "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-                );
+                let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">");
                 for x in v {
                     let _ = write!(s, "{x:e} ");
                 }
             }
             Field::Vector(name, v) => {
-                let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">");
+                let _ = writeln!(
+                    s,
+                    "<DataArray type=\"Float64\" Name=\"{name}\" NumberOfComponents=\"3\" format=\"ascii\">"
+                );
                 for x in v {
                     let _ = write!(s, "{:e} {:e} {:e} ", x[0], x[1], x[2]);
                 }
             }
             Field::Int(name, v) => {
-                let _ = writeln!(
-                    s,
-                    "<DataArray type=\"Int64\" Name=\"{name}\" format=\"ascii\">"
-                );
+                let _ = writeln!(s, "<DataArray type=\"Int64\" Name=\"{name}\" format=\"ascii\">");
                 for x in v {
                     let _ = write!(s, "{x} ");
                 }
@@ -54,7 +51,9 @@ pub fn write_vtu(path: &Path, points: &[[f64; 3]], fields: &[Field]) -> std::io:
         }
         s.push_str("\n</DataArray>\n");
     }
-    s.push_str("</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n");
+    s.push_str(
+        "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n",
+    );
     for p in points {
         let _ = write!(s, "{:e} {:e} {:e} ", p[0], p[1], p[2]);
     }
@@ -86,16 +85,15 @@ pub struct Series {
 impl Series {
     /// A series written to `pvd`; snapshot files are named relative to its folder.
     pub fn new(pvd: PathBuf) -> Self {
-        Self {
-            pvd,
-            entries: Vec::new(),
-        }
+        Self { pvd, entries: Vec::new() }
     }
 
     /// Adds a snapshot file (relative to the `.pvd`'s folder) at time `t`.
     pub fn push(&mut self, t: f64, file: &str) -> std::io::Result<()> {
         self.entries.push((t, file.to_string()));
-        let mut s = String::from("<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n");
+        let mut s = String::from(
+            "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n",
+        );
         for (t, f) in &self.entries {
             let _ = writeln!(s, "<DataSet timestep=\"{t:e}\" part=\"0\" file=\"{f}\"/>");
         }
@@ -115,19 +113,13 @@ mod tests {
         write_vtu(
             &p,
             &[[0.0, 0.0, 0.0], [1.0, 0.5, 0.0]],
-            &[
-                Field::Scalar("p", vec![1.0, 2.0]),
-                Field::Int("id", vec![0, 1]),
-            ],
+            &[Field::Scalar("p", vec![1.0, 2.0]), Field::Int("id", vec![0, 1])],
         )
         .unwrap();
         let s = std::fs::read_to_string(&p).unwrap();
         assert!(s.contains("NumberOfPoints=\"2\""));
         assert!(s.contains("Name=\"p\""));
-        assert_eq!(
-            s.matches("<DataArray").count(),
-            s.matches("</DataArray>").count()
-        );
+        assert_eq!(s.matches("<DataArray").count(), s.matches("</DataArray>").count());
         let mut series = Series::new(dir.path().join("s.pvd"));
         series.push(0.0, "a.vtu").unwrap();
         series.push(0.5, "b.vtu").unwrap();

@@ -71,11 +71,7 @@ impl<const D: usize> FluidRates<D> {
             du: vec![Vector::zeros(); n],
             dp: if pressure { vec![0.0; n] } else { Vec::new() },
             drho: if density { vec![0.0; n] } else { Vec::new() },
-            a_c: if transport {
-                vec![Vector::zeros(); n]
-            } else {
-                Vec::new()
-            },
+            a_c: if transport { vec![Vector::zeros(); n] } else { Vec::new() },
         }
     }
 }
@@ -89,33 +85,20 @@ impl<const D: usize> Fluid<D> {
             return Err(format!("fluid `{name}`: no particles"));
         }
         if !(h > 0.0 && h.is_finite()) {
-            return Err(format!(
-                "fluid `{name}`: smoothing length h = {h} must be positive"
-            ));
+            return Err(format!("fluid `{name}`: smoothing length h = {h} must be positive"));
         }
-        for (field, len) in [
-            ("u", init.u.len()),
-            ("m", init.m.len()),
-            ("rho", init.rho.len()),
-            ("p", init.p.len()),
-        ] {
+        for (field, len) in
+            [("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("p", init.p.len())]
+        {
             if len != n {
-                return Err(format!(
-                    "fluid `{name}`: {field} has {len} entries for {n} particles"
-                ));
+                return Err(format!("fluid `{name}`: {field} has {len} entries for {n} particles"));
             }
         }
         if let Some(i) = init.m.iter().position(|&m| !(m > 0.0)) {
-            return Err(format!(
-                "fluid `{name}`: particle {i} has non-positive mass {}",
-                init.m[i]
-            ));
+            return Err(format!("fluid `{name}`: particle {i} has non-positive mass {}", init.m[i]));
         }
         if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
-            return Err(format!(
-                "fluid `{name}`: particle {i} has non-positive density {}",
-                init.rho[i]
-            ));
+            return Err(format!("fluid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
         }
         let u_hat = transport.then(|| init.u.clone());
         Ok(Self {
@@ -202,25 +185,13 @@ mod tests {
             Fluid::new("water", 0.1, i, false).unwrap_err(),
             "fluid `water`: p has 2 entries for 3 particles"
         );
-        assert!(Fluid::new("water", -1.0, init(3), false)
-            .unwrap_err()
-            .contains("h = -1"));
+        assert!(Fluid::new("water", -1.0, init(3), false).unwrap_err().contains("h = -1"));
     }
 
     #[test]
     fn transport_velocity_is_allocated_only_when_declared() {
-        assert!(Fluid::new("f", 0.1, init(4), false)
-            .unwrap()
-            .u_hat
-            .is_none());
-        assert_eq!(
-            Fluid::new("f", 0.1, init(4), true)
-                .unwrap()
-                .u_hat
-                .unwrap()
-                .len(),
-            4
-        );
+        assert!(Fluid::new("f", 0.1, init(4), false).unwrap().u_hat.is_none());
+        assert_eq!(Fluid::new("f", 0.1, init(4), true).unwrap().u_hat.unwrap().len(), 4);
     }
 
     #[test]

@@ -8,7 +8,7 @@
 
 mod passes;
 
-pub use passes::{ipst_chi_reference, FluidPasses};
+pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -84,17 +84,9 @@ pub struct Corrections {
 
 impl Corrections {
     /// Every correction on (the paper's scheme).
-    pub const ALL: Self = Self {
-        continuity: true,
-        pressure: true,
-        momentum: true,
-    };
+    pub const ALL: Self = Self { continuity: true, pressure: true, momentum: true };
     /// Every correction off (TVF-like transport on an EDAC scheme).
-    pub const NONE: Self = Self {
-        continuity: false,
-        pressure: false,
-        momentum: false,
-    };
+    pub const NONE: Self = Self { continuity: false, pressure: false, momentum: false };
 }
 
 /// How the density is found.
@@ -254,9 +246,7 @@ impl SchemeName {
         // predictor-corrector whose final stage sets u~ = u + dt a_c, i.e. twice the
         // homogenisation of eq. (55): in our kick-drift-kick that is p_b = 2 rho0 c0^2.
         let background = |factor: f64| Transport {
-            shifting: Shifting::BackgroundPressure {
-                pb: factor * s.rho0 * s.c0 * s.c0,
-            },
+            shifting: Shifting::BackgroundPressure { pb: factor * s.rho0 * s.c0 * s.c0 },
             corrections: Corrections::NONE,
         };
         match self {
@@ -273,10 +263,7 @@ impl SchemeName {
             SchemeName::Tvf => FluidScheme {
                 name: self,
                 density: DensityModel::Summation,
-                pressure: PressureModel::StateEquation {
-                    c0: s.c0,
-                    rho0: s.rho0,
-                },
+                pressure: PressureModel::StateEquation { c0: s.c0, rho0: s.rho0 },
                 pressure_gradient: PressureGradient::Adami { bql: false },
                 viscosity: s.nu,
                 artificial_viscosity,
@@ -285,12 +272,7 @@ impl SchemeName {
             },
             SchemeName::Ctvf => {
                 let shifting = match s.pst {
-                    Pst::Sun => Some(Shifting::Sun2019 {
-                        ma_c0: s.u_ref,
-                        w_dx: s.w_dx,
-                        r: 0.2,
-                        n: 4,
-                    }),
+                    Pst::Sun => Some(Shifting::Sun2019 { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 }),
                     Pst::Ipst => Some(Shifting::Ipst {
                         u_max: s.u_ref,
                         tol: s.ipst_tol,
@@ -303,15 +285,10 @@ impl SchemeName {
                     name: self,
                     density: s.density,
                     pressure: edac,
-                    pressure_gradient: PressureGradient::Symmetric {
-                        bql: s.internal_flow,
-                    },
+                    pressure_gradient: PressureGradient::Symmetric { bql: s.internal_flow },
                     viscosity: s.nu,
                     artificial_viscosity,
-                    transport: shifting.map(|shifting| Transport {
-                        shifting,
-                        corrections: s.corrections,
-                    }),
+                    transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
                     gravity: s.gravity,
                 }
             }
@@ -323,49 +300,34 @@ impl fmt::Display for FluidScheme {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(f, "scheme {:?}", self.name)?;
         match self.density {
-            DensityModel::Summation => {
-                writeln!(f, "  density      summation: rho_a = sum m_b W_ab")?
-            }
+            DensityModel::Summation => writeln!(f, "  density      summation: rho_a = sum m_b W_ab")?,
             DensityModel::Continuity => writeln!(f, "  density      continuity, CTVF eq. (25)")?,
         }
         match self.pressure {
-            PressureModel::Edac { cs, nu } => writeln!(
-                f,
-                "  pressure     EDAC, CTVF eq. (26): c_s = {cs}, nu_edac = {nu:.6e}"
-            )?,
-            PressureModel::StateEquation { c0, rho0 } => writeln!(
-                f,
-                "  pressure     state equation (8): c0 = {c0}, rho0 = {rho0}"
-            )?,
+            PressureModel::Edac { cs, nu } => {
+                writeln!(f, "  pressure     EDAC, CTVF eq. (26): c_s = {cs}, nu_edac = {nu:.6e}")?
+            }
+            PressureModel::StateEquation { c0, rho0 } => {
+                writeln!(f, "  pressure     state equation (8): c0 = {c0}, rho0 = {rho0}")?
+            }
         }
         match self.pressure_gradient {
             PressureGradient::Symmetric { bql } => writeln!(
                 f,
                 "  grad p       symmetric, CTVF eq. (27){}",
-                if bql {
-                    " with BQL mean-pressure correction"
-                } else {
-                    ""
-                }
+                if bql { " with BQL mean-pressure correction" } else { "" }
             )?,
             PressureGradient::Adami { bql } => writeln!(
                 f,
                 "  grad p       Adami 2013{}",
-                if bql {
-                    " with BQL mean-pressure correction"
-                } else {
-                    ""
-                }
+                if bql { " with BQL mean-pressure correction" } else { "" }
             )?,
         }
         if let Some(nu) = self.viscosity {
             writeln!(f, "  viscosity    Morris, nu = {nu:.6e}")?;
         }
         if let Some((alpha, c)) = self.artificial_viscosity {
-            writeln!(
-                f,
-                "  art. visc.   Monaghan eq. (28): alpha = {alpha}, c = {c}"
-            )?;
+            writeln!(f, "  art. visc.   Monaghan eq. (28): alpha = {alpha}, c = {c}")?;
         }
         match &self.transport {
             None => writeln!(f, "  transport    none: particles move with u")?,

@@ -1,136 +1,141 @@
 //! The parallel loops. Each pass is a gather over the neighbours of every particle of one
 //! body, writing only that particle's own row: a plain rayon loop with no locks or atomics,
-//! and a neighbour order fixed by the cell list, so results are bit-for-bit identical for
-//! any number of threads.
+//! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
+//! for any number of threads.
 
 use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting};
 use crate::solver::equations::{
     artificial_viscosity, continuity, edac, momentum, shifting, viscosity, Pair, Point,
 };
-use crate::solver::kernel::Kernel;
+use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
-use crate::solver::nnps::{CellList, Domain};
+use crate::solver::nnps::{CellList, NeighbourList};
 use crate::solver::particles::{Fluid, FluidRates};
 use rayon::prelude::*;
 
 /// Particles per rayon task: large enough that scheduling is noise.
 const MIN_LEN: usize = 128;
 
+/// The neighbour list of a fluid body: each pair carries `(W_ab, (1/r) dW/dr)`, evaluated
+/// once per step when the list is built.
+pub type KernelList<const D: usize> = NeighbourList<D, (f64, f64)>;
+
+/// Builds the neighbour list of `fluid` with the kernel values of each pair.
+pub fn build_kernel_list<const D: usize>(
+    nl: &mut KernelList<D>,
+    cells: &CellList<D>,
+    fluid: &Fluid<D>,
+    k: &Kernel,
+) {
+    let k = k.scaled(fluid.h);
+    nl.build(cells, &fluid.x, |_, r2| k.w_and_grad_factor(r2.sqrt()));
+}
+
 #[inline(always)]
-fn pair<const D: usize>(k: &Kernel, h: f64, xij: Vector<D>, r2: f64) -> Pair<D> {
-    let (w, f) = k.w_and_grad_factor(r2.sqrt(), h);
-    Pair {
-        xij,
-        r2,
-        h,
-        wij: w,
-        dwij: xij * f,
-    }
+fn pair<const D: usize>(k: &ScaledKernel, xij: Vector<D>, r2: f64) -> Pair<D> {
+    let (w, f) = k.w_and_grad_factor(r2.sqrt());
+    Pair::new(xij, r2, k.h, w, f)
+}
+
+#[inline(always)]
+fn cached_pair<const D: usize>(h: f64, xij: Vector<D>, r2: f64, &(w, f): &(f64, f64)) -> Pair<D> {
+    Pair::new(xij, r2, h, w, f)
 }
 
 #[inline(always)]
 fn point<const D: usize>(f: &Fluid<D>, u_hat: &[Vector<D>], i: usize) -> Point<D> {
-    Point {
-        u: f.u[i],
-        u_hat: u_hat[i],
-        m: f.m[i],
-        rho: f.rho[i],
-        p: f.p[i],
-    }
+    Point::new(f.u[i], u_hat[i], f.m[i], f.rho[i], f.p[i])
+}
+
+/// Every particle's [`Point`], gathered once per pass so that each neighbour visit reads
+/// one record and divides nothing.
+fn gather_points<const D: usize>(f: &Fluid<D>, out: &mut Vec<Point<D>>) {
+    let u_hat = f.u_hat();
+    out.resize(f.len(), point(f, u_hat, 0));
+    out.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, p)| *p = point(f, u_hat, i));
 }
 
 /// Scratch state of the fluid passes that must survive between steps without allocating:
-/// the IPST work arrays and their own cell list.
-#[derive(Clone, Debug)]
+/// the gathered particle views and the IPST work arrays.
+#[derive(Clone, Debug, Default)]
 pub struct FluidPasses<const D: usize> {
-    ipst_cells: Option<CellList<D>>,
     x_shift: Vec<Vector<D>>,
     dr: Vec<Vector<D>>,
     chi: Vec<f64>,
+    points: Vec<Point<D>>,
     /// IPST iterations taken in the last step (for logs and benchmarks).
     pub last_ipst_iterations: usize,
 }
 
 impl<const D: usize> FluidPasses<D> {
-    /// Work space for `scheme` (the IPST arrays only when IPST is declared).
-    pub fn new(scheme: &FluidScheme, domain: Domain<D>, radius: f64) -> Self {
-        let ipst = matches!(
-            scheme.transport.map(|t| t.shifting),
-            Some(Shifting::Ipst { .. })
-        );
+    /// Empty work space; the arrays grow on first use (IPST's only when it is declared).
+    pub fn new() -> Self {
         Self {
-            ipst_cells: ipst.then(|| CellList::new(domain, radius)),
             x_shift: Vec::new(),
             dr: Vec::new(),
             chi: Vec::new(),
+            points: Vec::new(),
             last_ipst_iterations: 0,
         }
     }
 
     /// Summation density, `rho_a = sum_b m_b W_ab`.
-    pub fn summation_density(fluid: &mut Fluid<D>, cells: &CellList<D>, k: &Kernel) {
-        let h = fluid.h;
+    pub fn summation_density(fluid: &mut Fluid<D>, nl: &KernelList<D>) {
         let (x, m) = (&fluid.x, &fluid.m);
-        fluid
-            .rho
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, rho)| {
-                let mut s = 0.0;
-                cells.for_each_neighbour(x, &x[i], |j, _, r2| {
-                    s += m[j] * k.w(r2.sqrt(), h);
-                });
-                *rho = s;
-            });
+        fluid.rho.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, rho)| {
+            let mut s = 0.0;
+            nl.for_each(i, x, |j, _, _, &(w, _)| s += m[j] * w);
+            *rho = s;
+        });
     }
 
     /// Pass A: the density and pressure rates (eqs. 25 and 26), then their explicit
     /// update over `dt` (eqs. 56-57); or the state equation (8).
     pub fn update_density_and_pressure(
+        &mut self,
         fluid: &mut Fluid<D>,
-        cells: &CellList<D>,
-        k: &Kernel,
+        nl: &KernelList<D>,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
+        let h = fluid.h;
+        gather_points(fluid, &mut self.points);
+        let pts = &self.points;
         let continuity_on = s.density == DensityModel::Continuity;
         let corr = s.transport.map(|t| t.corrections);
+        let continuity_corr = corr.is_some_and(|c| c.continuity);
         match s.pressure {
             PressureModel::StateEquation { c0, rho0 } => {
                 if continuity_on {
-                    Self::density_rate(
-                        fluid,
-                        cells,
-                        k,
-                        corr.is_some_and(|c| c.continuity),
-                        &mut rates.drho,
-                    );
+                    let x = &fluid.x;
+                    rates.drho.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, out)| {
+                        let a = &pts[i];
+                        let mut s = 0.0;
+                        nl.for_each(i, x, |j, xij, r2, kw| {
+                            let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
+                            s += continuity::transport_divergence(&a, &b, &ab);
+                            if continuity_corr {
+                                s += continuity::correction(&a, &b, &ab);
+                            }
+                        });
+                        *out = s;
+                    });
                     apply(&mut fluid.rho, &rates.drho, dt);
                 }
                 let c2 = c0 * c0;
-                fluid
-                    .p
-                    .par_iter_mut()
-                    .zip(&fluid.rho)
-                    .for_each(|(p, &rho)| *p = c2 * (rho - rho0));
+                fluid.p.par_iter_mut().zip(&fluid.rho).for_each(|(p, &rho)| *p = c2 * (rho - rho0));
             }
             PressureModel::Edac { cs, nu } => {
                 let cs2 = cs * cs;
                 let pressure_corr = corr.is_some_and(|c| c.pressure);
-                let continuity_corr = corr.is_some_and(|c| c.continuity);
-                let h = fluid.h;
-                let f: &Fluid<D> = fluid;
-                let u_hat = f.u_hat();
+                let x = &fluid.x;
                 let rate = |i: usize| -> (f64, f64) {
-                    let a = point(f, u_hat, i);
+                    let a = &pts[i];
                     let (mut dp, mut drho) = (0.0, 0.0);
-                    cells.for_each_neighbour(&f.x, &f.x[i], |j, xij, r2| {
-                        let ab = pair(k, h, xij, r2);
-                        let b = point(f, u_hat, j);
-                        dp += edac::compressibility(&a, &b, &ab, cs2)
-                            + edac::diffusion(&a, &b, &ab, nu);
+                    nl.for_each(i, x, |j, xij, r2, kw| {
+                        let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
+                        dp += edac::compressibility(&a, &b, &ab, cs2) + edac::diffusion(&a, &b, &ab, nu);
                         if pressure_corr {
                             dp += edac::transport_correction(&a, &b, &ab);
                         }
@@ -165,87 +170,56 @@ impl<const D: usize> FluidPasses<D> {
         }
     }
 
-    fn density_rate(
-        fluid: &Fluid<D>,
-        cells: &CellList<D>,
-        k: &Kernel,
-        corrected: bool,
-        drho: &mut [f64],
-    ) {
-        let h = fluid.h;
-        let u_hat = fluid.u_hat();
-        drho.par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, out)| {
-                let a = point(fluid, u_hat, i);
-                let mut s = 0.0;
-                cells.for_each_neighbour(&fluid.x, &fluid.x[i], |j, xij, r2| {
-                    let ab = pair(k, h, xij, r2);
-                    let b = point(fluid, u_hat, j);
-                    s += continuity::transport_divergence(&a, &b, &ab);
-                    if corrected {
-                        s += continuity::correction(&a, &b, &ab);
-                    }
-                });
-                *out = s;
-            });
-    }
-
     /// Pass B: the acceleration (eq. 27 or its Adami form) and, for the shifting
     /// techniques that are sums over neighbours, the homogenisation acceleration.
     /// `dt` is the step the homogenisation will be applied over (eq. 36 divides by it).
     pub fn accelerations(
+        &mut self,
         fluid: &Fluid<D>,
-        cells: &CellList<D>,
-        k: &Kernel,
+        nl: &KernelList<D>,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
         let h = fluid.h;
-        let u_hat = fluid.u_hat();
+        gather_points(fluid, &mut self.points);
+        let pts = &self.points;
         let mut g = Vector::<D>::zeros();
         for d in 0..D.min(3) {
             g[d] = s.gravity[d];
         }
         let shifting = s.transport.map(|t| t.shifting);
-        let corr = s.transport.map(|t| t.corrections);
-        let momentum_corr = corr.is_some_and(|c| c.momentum);
+        let momentum_corr = s.transport.is_some_and(|t| t.corrections.momentum);
         let transport = s.transport.is_some();
         let sun_prefactor = match shifting {
             // -(Ma c0) 2h / dt, eq. (36)
-            Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * h / dt,
+            Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
             _ => 0.0,
         };
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
-            let a = point(fluid, u_hat, i);
+            let a = &pts[i];
             let mut acc = Vector::<D>::zeros();
             let mut ac = Vector::<D>::zeros();
             // BQL: the reference weights and the neighbour-mean pressure, combined at the end.
             let (mut c_ref, mut p_sum, mut n_nb) = (Vector::<D>::zeros(), 0.0, 0usize);
-            cells.for_each_neighbour(&fluid.x, &fluid.x[i], |j, xij, r2| {
-                let ab = pair(k, h, xij, r2);
-                let b = point(fluid, u_hat, j);
-                let (grad, bql) = match s.pressure_gradient {
+            nl.for_each(i, &fluid.x, |j, xij, r2, kw| {
+                let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
+                match s.pressure_gradient {
                     PressureGradient::Symmetric { bql } => {
-                        (momentum::pressure_gradient(&a, &b, &ab), bql)
+                        acc += momentum::pressure_gradient(&a, &b, &ab);
+                        if bql {
+                            c_ref += momentum::pressure_reference_weight(&a, &b, &ab);
+                        }
                     }
                     PressureGradient::Adami { bql } => {
-                        (momentum::pressure_gradient_adami(&a, &b, &ab), bql)
-                    }
-                };
-                acc += grad;
-                if bql {
-                    c_ref += match s.pressure_gradient {
-                        PressureGradient::Symmetric { .. } => {
-                            momentum::pressure_reference_weight(&a, &b, &ab)
+                        acc += momentum::pressure_gradient_adami(&a, &b, &ab);
+                        if bql {
+                            c_ref += momentum::adami_weight(&a, &b, &ab);
                         }
-                        PressureGradient::Adami { .. } => momentum::adami_weight(&a, &b, &ab),
-                    };
-                    p_sum += b.p;
-                    n_nb += 1;
+                    }
                 }
+                p_sum += b.p;
+                n_nb += 1;
                 if let Some(nu) = s.viscosity {
                     acc += viscosity::morris(&a, &b, &ab, nu);
                 }
@@ -268,38 +242,26 @@ impl<const D: usize> FluidPasses<D> {
                     }
                 }
             });
-            if n_nb > 0 {
-                // BQL: the gradient with the neighbour-mean pressure as reference; the
-                // mean is constant over the sum, so it is applied once here.
-                acc += c_ref * (p_sum / n_nb as f64);
-            }
+            // BQL: the gradient with the neighbour-mean pressure as reference; the mean is
+            // constant over the sum, so it is applied once here (c_ref is zero without BQL).
+            acc += c_ref * (p_sum / n_nb.max(1) as f64);
             if matches!(shifting, Some(Shifting::Sun2019 { .. })) {
                 ac *= sun_prefactor;
             }
             (acc + g, ac)
         };
-        if transport {
+        let ipst = matches!(shifting, Some(Shifting::Ipst { .. }));
+        if transport && !ipst {
             rates
                 .du
                 .par_iter_mut()
                 .zip(rates.a_c.par_iter_mut())
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, (du, ac))| {
-                    let (d, c) = rate(i);
-                    *du = d;
-                    // IPST fills a_c in its own pass.
-                    if !matches!(shifting, Some(Shifting::Ipst { .. })) {
-                        *ac = c;
-                    }
-                });
+                .for_each(|(i, (du, ac))| (*du, *ac) = rate(i));
         } else {
-            rates
-                .du
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(MIN_LEN)
-                .for_each(|(i, du)| *du = rate(i).0);
+            // Without transport there is no a_c; IPST fills it in its own pass.
+            rates.du.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, du)| *du = rate(i).0);
         }
     }
 
@@ -307,92 +269,74 @@ impl<const D: usize> FluidPasses<D> {
     /// `|max chi - chi_ref| <= tol chi_ref` (eq. 39, chi of eq. 40) or `max_iter` moves,
     /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41). The particles themselves are not
     /// moved: the kick of the next step applies the displacement through u~.
+    ///
+    /// The iterations reuse the step's neighbour list with the kernel re-evaluated at the
+    /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
+    /// are those entering the support from outside it during the iterations, whose kernel
+    /// value is of the fifth order in the distance they moved in (quintic spline).
     pub fn ipst(
         &mut self,
         fluid: &Fluid<D>,
-        domain: &Domain<D>,
+        nl: &KernelList<D>,
         k: &Kernel,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
-        let Some(Shifting::Ipst {
-            u_max,
-            tol,
-            max_iter,
-            chi_ref,
-        }) = s.transport.map(|t| t.shifting)
-        else {
+        let Some(Shifting::Ipst { u_max, tol, max_iter, chi_ref }) = s.transport.map(|t| t.shifting) else {
             return;
         };
-        let cells = self.ipst_cells.as_mut().expect("IPST work space");
+        let k = k.scaled(fluid.h);
         let n = fluid.len();
-        let h = fluid.h;
         self.x_shift.clear();
         self.x_shift.extend_from_slice(&fluid.x);
         self.dr.resize(n, Vector::zeros());
         self.chi.resize(n, 0.0);
-        let u_hat = fluid.u_hat();
+        // The volumes gathered by `accelerations` at these positions.
+        let pts = &self.points;
         let mut iterations = 0;
         while iterations < max_iter {
-            cells.update(&self.x_shift);
-            let xs = &self.x_shift;
-            let c: &CellList<D> = cells;
-            self.dr
-                .par_iter_mut()
-                .zip(self.chi.par_iter_mut())
-                .enumerate()
-                .with_min_len(MIN_LEN)
-                .for_each(|(i, (dr, chi))| {
+            let xs: &[Vector<D>] = &self.x_shift;
+            self.dr.par_iter_mut().zip(self.chi.par_iter_mut()).enumerate().with_min_len(MIN_LEN).for_each(
+                |(i, (dr, chi))| {
                     let (mut d, mut x) = (Vector::<D>::zeros(), 0.0);
-                    c.for_each_neighbour(xs, &xs[i], |j, xij, r2| {
-                        let ab = pair(k, h, xij, r2);
-                        let b = point(fluid, u_hat, j);
-                        d += shifting::ipst_displacement(&b, &ab);
+                    nl.for_each(i, xs, |j, xij, r2, _| {
+                        let (ab, b) = (pair(&k, xij, r2), &pts[j]);
+                        d += shifting::ipst_displacement(b, &ab);
                         x += shifting::ipst_chi(&ab);
                     });
                     *dr = d * (u_max * dt);
                     *chi = x;
-                });
+                },
+            );
             let chi_max = self.chi.iter().fold(f64::MIN, |m, &v| m.max(v));
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
                 break;
             }
+            // Not wrapped: the list's image shifts refer to the unwrapped positions.
             for (x, dr) in self.x_shift.iter_mut().zip(&self.dr) {
                 *x += dr;
-                domain.wrap(x);
             }
             iterations += 1;
         }
         self.last_ipst_iterations = iterations;
         let f = 2.0 / (dt * dt);
         let (x0, xs) = (&fluid.x, &self.x_shift);
-        rates
-            .a_c
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(i, ac)| {
-                *ac = domain.delta(&xs[i], &x0[i]) * f;
-            });
+        rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
+            *ac = (xs[i] - x0[i]) * f;
+        });
     }
 }
 
 /// chi_ref of eq. (39): the mean of `chi = h^2 sum W` over the initial configuration for
 /// internal flows (the authors' internal-flow choice: a perturbed lattice has no single
 /// value), the maximum with a free surface (CTVF sec. 3.3.2).
-pub fn ipst_chi_reference<const D: usize>(
-    fluid: &Fluid<D>,
-    cells: &CellList<D>,
-    k: &Kernel,
-    free_surface: bool,
-) -> f64 {
-    let h = fluid.h;
+pub fn ipst_chi_reference<const D: usize>(fluid: &Fluid<D>, nl: &KernelList<D>, free_surface: bool) -> f64 {
     let chi: Vec<f64> = (0..fluid.len())
         .map(|i| {
             let mut s = 0.0;
-            cells.for_each_neighbour(&fluid.x, &fluid.x[i], |_, _, r2| {
-                s += h * h * k.w(r2.sqrt(), h)
+            nl.for_each(i, &fluid.x, |_, xij, r2, kw| {
+                s += shifting::ipst_chi(&cached_pair(fluid.h, xij, r2, kw))
             });
             s
         })

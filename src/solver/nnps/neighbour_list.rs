@@ -1,0 +1,168 @@
+//! Neighbour lists built once per step from a cell list and reused by every pass of the
+//! step: the candidate search (and its unpredictable distance branch) is paid once, not
+//! once per pass. Each entry packs the neighbour index with the periodic image it was
+//! found through, so a pass recovers `x_ij` without a minimum-image rounding, and carries
+//! a payload computed once per pair at build time (SPH stores the kernel value and
+//! gradient factor there: the kernel is then evaluated once per pair and step).
+
+use super::CellList;
+use crate::solver::math::Vector;
+use rayon::prelude::*;
+
+/// Particles per build task; the lists are stored per chunk so building allocates nothing
+/// once the chunks have grown, and the result does not depend on the thread count.
+const CHUNK: usize = 512;
+/// Bits of an entry holding the neighbour index (the rest hold the image code).
+const J_BITS: u32 = 26;
+const J_MASK: u32 = (1 << J_BITS) - 1;
+
+#[derive(Clone, Debug, Default)]
+struct Chunk<P> {
+    start: Vec<u32>,
+    entries: Vec<u32>,
+    payload: Vec<P>,
+}
+
+/// For every point of a body, its neighbours within the search radius in the same body,
+/// each with a payload `P` computed from the pair at build time.
+#[derive(Clone, Debug, Default)]
+pub struct NeighbourList<const D: usize, P = ()> {
+    chunks: Vec<Chunk<P>>,
+    /// Image shift per code: code = sum_k (wraps_k + 1) 3^k.
+    shifts: Vec<Vector<D>>,
+}
+
+impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
+    /// An empty list.
+    pub fn new() -> Self {
+        Self { chunks: Vec::new(), shifts: Vec::new() }
+    }
+
+    /// Lists the neighbours of every point of `points` (which `cells` binned) among the
+    /// same points, with `payload(x_ij, r2)` per pair. Panics if the body has 2^26 points
+    /// or more.
+    pub fn build(
+        &mut self,
+        cells: &CellList<D>,
+        points: &[Vector<D>],
+        payload: impl Fn(Vector<D>, f64) -> P + Sync,
+    ) {
+        let n = points.len();
+        assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
+        self.shifts.clear();
+        for code in 0..3usize.pow(D as u32) {
+            let mut wraps = [0i8; D];
+            let mut c = code;
+            for w in wraps.iter_mut() {
+                *w = (c % 3) as i8 - 1;
+                c /= 3;
+            }
+            self.shifts.push(cells.shift(wraps));
+        }
+        self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
+        let shifts = &self.shifts;
+        let r2max = cells.radius2();
+        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+            chunk.start.clear();
+            chunk.entries.clear();
+            chunk.payload.clear();
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                let first = chunk.entries.len();
+                chunk.start.push(first as u32);
+                cells.for_each_candidate_cell(&points[i], |candidates, q, wraps| {
+                    let mut code = 0u32;
+                    for k in (0..D).rev() {
+                        debug_assert!(
+                            (-1..=1).contains(&wraps[k]),
+                            "self-queries wrap by one period at most"
+                        );
+                        code = code * 3 + (wraps[k] + 1) as u32;
+                    }
+                    // Append every candidate, advancing the length only for neighbours:
+                    // no branch on the distance test, which is unpredictable.
+                    let mut len = chunk.entries.len();
+                    chunk.entries.resize(len + candidates.len(), 0);
+                    for &j in candidates {
+                        chunk.entries[len] = j | (code << J_BITS);
+                        len += ((q - points[j as usize]).norm_squared() < r2max) as usize;
+                    }
+                    chunk.entries.truncate(len);
+                });
+                // The payload of the accepted pairs, in a loop without the distance branch.
+                let xi = points[i];
+                for &e in &chunk.entries[first..] {
+                    let xij = (xi - shifts[(e >> J_BITS) as usize]) - points[(e & J_MASK) as usize];
+                    chunk.payload.push(payload(xij, xij.norm_squared()));
+                }
+            }
+            chunk.start.push(chunk.entries.len() as u32);
+        });
+    }
+
+    /// Calls `f(j, x_ij, r2, payload)` for every neighbour `j` of point `i` (itself
+    /// included), in the order of the cell list. `points` must be the positions the list
+    /// was built from.
+    #[inline(always)]
+    pub fn for_each<F: FnMut(usize, Vector<D>, f64, &P)>(&self, i: usize, points: &[Vector<D>], mut f: F) {
+        let chunk = &self.chunks[i / CHUNK];
+        let l = i % CHUNK;
+        let xi = points[i];
+        let range = chunk.start[l] as usize..chunk.start[l + 1] as usize;
+        for (&e, p) in chunk.entries[range.clone()].iter().zip(&chunk.payload[range]) {
+            let j = (e & J_MASK) as usize;
+            let xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[j];
+            f(j, xij, xij.norm_squared(), p);
+        }
+    }
+
+    /// Total number of (ordered) pairs.
+    pub fn pairs(&self) -> usize {
+        self.chunks.iter().map(|c| c.entries.len()).sum()
+    }
+
+    /// Bytes held by the lists.
+    pub fn bytes(&self) -> usize {
+        self.chunks
+            .iter()
+            .map(|c| {
+                4 * (c.entries.capacity() + c.start.capacity())
+                    + c.payload.capacity() * std::mem::size_of::<P>()
+            })
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{brute_force_neighbours, Domain};
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    #[test]
+    fn lists_equal_brute_force_with_exact_differences() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(9);
+        for periodic in [[true, true], [false, false], [true, false]] {
+            let d = Domain { min: [0.0, 0.0], max: [1.0, 0.8], periodic };
+            let pts: Vec<Vector<2>> =
+                (0..1500).map(|_| Vector::<2>::new(rng.gen(), 0.8 * rng.gen::<f64>())).collect();
+            let radius = 0.07;
+            let mut cells = CellList::new(d, radius);
+            cells.update(&pts);
+            let mut nl = NeighbourList::<2, f64>::new();
+            nl.build(&cells, &pts, |_, r2| r2);
+            let brute = brute_force_neighbours(&d, radius, &pts, &pts);
+            for i in 0..pts.len() {
+                let mut v = Vec::new();
+                nl.for_each(i, &pts, |j, xij, r2, &payload| {
+                    assert_eq!(payload, r2);
+                    assert!((xij - d.delta(&pts[i], &pts[j])).norm() < 1e-12);
+                    assert!(r2 < radius * radius);
+                    v.push(j);
+                });
+                v.sort();
+                assert_eq!(v, brute[i], "point {i}");
+            }
+            assert_eq!(nl.pairs(), brute.iter().map(|v| v.len()).sum::<usize>());
+        }
+    }
+}
