@@ -40,6 +40,13 @@ enum Command {
         /// Write `time tf steps` to this file about twice a second.
         #[arg(long, hide = true)]
         progress_file: Option<PathBuf>,
+        /// Write DIR/checkpoint.json every SECONDS of stepping (and on Ctrl-C); a run of
+        /// the same case into the same folder resumes from it.
+        #[arg(long, value_name = "SECONDS")]
+        checkpoint_every: Option<f64>,
+        /// Stop after N steps as if interrupted, checkpointing first (tests the resume path).
+        #[arg(long, hide = true)]
+        stop_after_steps: Option<u64>,
     },
     /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
     Bench {
@@ -101,7 +108,16 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
-        Command::Simulate { scene, sets, out, quiet, force, progress_file } => {
+        Command::Simulate {
+            scene,
+            sets,
+            out,
+            quiet,
+            force,
+            progress_file,
+            checkpoint_every,
+            stop_after_steps,
+        } => {
             let entry = match scenes::find(&scene) {
                 Ok(e) => e,
                 Err(e) => {
@@ -116,7 +132,8 @@ fn main() -> ExitCode {
                     return ExitCode::from(2);
                 }
             };
-            let opts = harness::RunOptions { quiet, force, progress_file };
+            let opts =
+                harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps };
             match harness::run(entry, &params, &out, &opts) {
                 Ok(s) => match s.status {
                     sphrepro::solver::output::summary::Status::Completed => {

@@ -22,6 +22,26 @@ pub struct RunOptions {
     pub force: bool,
     /// Write `time tf steps` here about twice a second (for a parent runner's progress).
     pub progress_file: Option<PathBuf>,
+    /// Write `checkpoint.json` after at most this many wall-clock seconds of stepping
+    /// (and always on Ctrl-C); a later run of the same case in the same folder resumes
+    /// from it, bit for bit.
+    pub checkpoint_every: Option<f64>,
+    /// Stop (as if interrupted) after this many steps, checkpointing first: for tests of
+    /// the resume path.
+    pub stop_after_steps: Option<u64>,
+}
+
+/// What `checkpoint.json` holds: the scene's evolving state and the run's bookkeeping.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Checkpoint {
+    params: Params,
+    next_output: f64,
+    next_sample: f64,
+    snapshot_index: usize,
+    stepping: f64,
+    ts_rows: usize,
+    series: BTreeMap<String, Vec<(f64, String)>>,
+    scene: serde_json::Value,
 }
 
 /// A run that did not produce a result.
@@ -84,20 +104,47 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let _ = std::fs::write(out.join("plan.txt"), &plan);
 
     let ts_path = out.join("timeseries.csv");
-    let mut ts = csv::Writer::from_writer(
-        std::fs::File::create(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?,
-    );
     let vtu_dir = out.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|e| RunError::Input(io_err(&vtu_dir, e)))?;
+    let ckpt_path = out.join("checkpoint.json");
     let mut series: BTreeMap<String, Series> = BTreeMap::new();
-
-    let bar = progress_bar(opts.quiet);
-    let mut progress_file = ProgressFile::new(opts.progress_file.clone());
     let mut stepping = 0.0f64;
     let mut snapshot_index = 0usize;
     let mut next_output = 0.0f64;
     let mut next_sample = 0.0f64;
-    let mut header_written = false;
+    let mut ts_rows = 0usize;
+    // Resume from a checkpoint of this very case, if one is there.
+    match read_checkpoint(&ckpt_path, params) {
+        Some(c) => {
+            scene
+                .load_state(c.scene)
+                .map_err(|e| RunError::Input(format!("{}: {e}", ckpt_path.display())))?;
+            truncate_rows(&ts_path, c.ts_rows).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
+            (stepping, snapshot_index, next_output, next_sample, ts_rows) =
+                (c.stepping, c.snapshot_index, c.next_output, c.next_sample, c.ts_rows);
+            for (body, entries) in c.series {
+                let pvd = out.join(format!("{body}.pvd"));
+                series.insert(body, Series::with_entries(pvd, entries));
+            }
+            if !opts.quiet {
+                eprintln!("resuming from {} at t = {}", ckpt_path.display(), scene.time());
+            }
+        }
+        None => {
+            let _ = std::fs::remove_file(&ckpt_path);
+            std::fs::File::create(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
+        }
+    }
+    let mut ts = csv::Writer::from_writer(
+        std::fs::OpenOptions::new()
+            .append(true)
+            .open(&ts_path)
+            .map_err(|e| RunError::Input(io_err(&ts_path, e)))?,
+    );
+
+    let bar = progress_bar(opts.quiet);
+    let mut progress_file = ProgressFile::new(opts.progress_file.clone());
+    let mut last_checkpoint = Instant::now();
     let particles = scene.particles() as f64;
     let eps = 1e-12 * tf.max(1.0);
     let outcome = loop {
@@ -106,7 +153,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         if t >= next_sample - eps || at_end {
             let row = scene.sample();
             let written = (|| -> csv::Result<()> {
-                if !header_written {
+                if ts_rows == 0 {
                     ts.write_record(row.iter().map(|(k, _)| *k))?;
                 }
                 ts.write_record(row.iter().map(|(_, v)| format!("{v:e}")))?;
@@ -116,8 +163,10 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             if let Err(e) = written {
                 break Outcome::Failed(format!("{}: {e}", ts_path.display()));
             }
-            header_written = true;
-            next_sample += sample_dt;
+            ts_rows += 1;
+            while next_sample <= t + eps {
+                next_sample += sample_dt;
+            }
         }
         if t >= next_output - eps || at_end {
             let written = scene.snapshot(&vtu_dir, snapshot_index).and_then(|files| {
@@ -131,32 +180,57 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 break Outcome::Failed(io_err(&vtu_dir, e));
             }
             snapshot_index += 1;
-            next_output += output_dt;
+            while next_output <= t + eps {
+                next_output += output_dt;
+            }
         }
         if at_end {
             break Outcome::Completed;
         }
+        // Output happens at the first step boundary at or after each output time: steps
+        // are never shortened for output, so the cadence does not change the solution.
         let target = next_sample.min(next_output).min(tf);
         let ts0 = Instant::now();
-        let mut interrupted = false;
-        let res = scene.advance_to(target, &mut |time, steps| {
+        let res = scene.advance(target, tf, &mut |time, steps| {
             if let Some(b) = &bar {
                 b.set_position((time / tf * 1000.0) as u64);
                 b.set_message(format!("t = {time:.4}/{tf}  step {steps}"));
             }
             progress_file.update(time, tf, steps);
-            interrupted |= INTERRUPTED.load(Ordering::Relaxed);
+            !INTERRUPTED.load(Ordering::Relaxed) && opts.stop_after_steps.is_none_or(|n| steps < n)
         });
         stepping += ts0.elapsed().as_secs_f64();
         if let Some(b) = &bar {
             let rate = particles * scene.steps() as f64 / stepping.max(1e-9);
             b.set_message(format!("t = {:.4}/{tf}  {rate:.3e} particle-steps/s", scene.time()));
         }
-        if let Err(d) = res {
-            break Outcome::Diverged(d);
+        let reached = match res {
+            Ok(reached) => reached,
+            Err(d) => break Outcome::Diverged(d),
+        };
+        // At a step boundary: checkpoint when stopped early or when it is time to.
+        let due = opts.checkpoint_every.is_some_and(|s| last_checkpoint.elapsed().as_secs_f64() >= s);
+        if !reached || due {
+            let c = Checkpoint {
+                params: params.clone(),
+                next_output,
+                next_sample,
+                snapshot_index,
+                stepping,
+                ts_rows,
+                series: series.iter().map(|(b, s)| (b.clone(), s.entries().to_vec())).collect(),
+                scene: scene.save_state(),
+            };
+            let json = serde_json::to_vec(&c).expect("checkpoint serialises");
+            if let Err(e) = crate::solver::output::write_atomic(&ckpt_path, &json) {
+                break Outcome::Failed(io_err(&ckpt_path, e));
+            }
+            last_checkpoint = Instant::now();
         }
-        if interrupted {
-            break Outcome::Failed("interrupted".into());
+        if !reached {
+            break Outcome::Failed(
+                "interrupted (checkpoint written: the next run of this case resumes)".into(),
+            );
         }
     };
     if let Some(b) = &bar {
@@ -173,6 +247,10 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         s.final_time = d.time;
     }
     let written = s.write(out).map_err(|e| io_err(&summary_path, e));
+    if written.is_ok() && status != Status::Failed {
+        // A finished result needs no checkpoint (and must not be resumed into).
+        let _ = std::fs::remove_file(&ckpt_path);
+    }
     match (outcome, written) {
         (Outcome::Failed(r), _) => Err(RunError::Failed(r)),
         (_, Err(e)) => Err(RunError::Failed(e)),
@@ -219,6 +297,24 @@ fn summary(
         metrics,
         provenance: Provenance::now(started),
     }
+}
+
+/// The checkpoint in `path` if it was written for `params`.
+fn read_checkpoint(path: &Path, params: &Params) -> Option<Checkpoint> {
+    let bytes = std::fs::read(path).ok()?;
+    let c: Checkpoint = serde_json::from_slice(&bytes).ok()?;
+    (c.params == *params).then_some(c)
+}
+
+/// Keeps the header and the first `rows` rows of a CSV file.
+fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
+    let text = std::fs::read_to_string(path).unwrap_or_default();
+    let kept: Vec<&str> = text.lines().take(if rows == 0 { 0 } else { rows + 1 }).collect();
+    let mut out = kept.join("\n");
+    if !out.is_empty() {
+        out.push('\n');
+    }
+    crate::solver::output::write_atomic(path, out.as_bytes())
 }
 
 fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {

@@ -23,8 +23,15 @@ pub trait SceneRun {
     fn steps(&self) -> u64;
     /// The plan (bodies, scheme and terms), written at the top of the run log.
     fn plan(&self) -> String;
-    /// Advances to `t` exactly, calling `on_step(time, steps)` after every step.
-    fn advance_to(&mut self, t: f64, on_step: &mut dyn FnMut(f64, u64)) -> Result<(), Divergence>;
+    /// Steps until the time reaches `t_stop` (steps are not shortened for it) without
+    /// passing `t_end` (the step that would is shortened), calling `on_step(time, steps)`
+    /// after every step; stops early (returning `Ok(false)`) when `on_step` returns false.
+    fn advance(
+        &mut self,
+        t_stop: f64,
+        t_end: f64,
+        on_step: &mut dyn FnMut(f64, u64) -> bool,
+    ) -> Result<bool, Divergence>;
     /// One time-series row: named values at the current time (the first is `t`).
     fn sample(&mut self) -> Vec<(&'static str, f64)>;
     /// Writes the bodies' snapshots for output number `index` into `dir`; returns the file
@@ -32,6 +39,12 @@ pub trait SceneRun {
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>>;
     /// The metrics of `summary.json` at the end of a completed run.
     fn metrics(&self) -> BTreeMap<String, f64>;
+    /// Everything that evolves (bodies, rates, time, the scene's running extrema), for a
+    /// checkpoint from which the run resumes bit for bit.
+    fn save_state(&self) -> serde_json::Value;
+    /// Restores a state written by [`save_state`](Self::save_state) of the same scene
+    /// built from the same parameters.
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String>;
 }
 
 /// A registered scene.

@@ -267,8 +267,22 @@ impl SceneRun for TaylorGreen {
             self.sim.state.scheme
         )
     }
-    fn advance_to(&mut self, t: f64, on_step: &mut dyn FnMut(f64, u64)) -> Result<(), Divergence> {
-        self.sim.advance_to(t, |s| on_step(s.time(), s.steps()))
+    fn advance(
+        &mut self,
+        t_stop: f64,
+        t_end: f64,
+        on_step: &mut dyn FnMut(f64, u64) -> bool,
+    ) -> Result<bool, Divergence> {
+        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
+    }
+    fn save_state(&self) -> serde_json::Value {
+        serde_json::json!({ "sim": &self.sim.state, "l1_max": self.l1_max })
+    }
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
+        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.l1_max = state["l1_max"].as_f64().ok_or("checkpoint: no l1_max")?;
+        self.sim.restore(sim);
+        Ok(())
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let e = self.errors();

@@ -128,16 +128,13 @@ impl<const D: usize> Simulation<D> {
         Ok(sim)
     }
 
-    /// Resumes from a checkpointed state (the cell list is rebuilt from the positions,
-    /// which are already in cell order, so the neighbour order is the same).
-    pub fn resume(domain: Domain<D>, kernel: Kernel, time_settings: TimeSettings, state: State<D>) -> Self {
-        let radius = kernel.support() * state.fluid.h;
-        let mut cells = CellList::new(domain, radius);
-        cells.update(&state.fluid.x);
-        let mut neighbours = KernelList::new();
-        build_kernel_list(&mut neighbours, &cells, &state.fluid, &kernel);
-        let passes = FluidPasses::new();
-        Self { domain, kernel, time_settings, state, cells, neighbours, passes }
+    /// Replaces the evolving state by a checkpointed one (taken at a step boundary of a
+    /// simulation built from the same parameters). The particles are stored in cell order,
+    /// so re-binning them reproduces the neighbour order, and the run continues bit for bit.
+    pub fn restore(&mut self, state: State<D>) {
+        self.state = state;
+        self.cells.update(&self.state.fluid.x);
+        build_kernel_list(&mut self.neighbours, &self.cells, &self.state.fluid, &self.kernel);
     }
 
     /// The fluid body.
@@ -238,15 +235,26 @@ impl<const D: usize> Simulation<D> {
         self.check()
     }
 
-    /// Steps until `t_end` is reached exactly (the last step is shortened).
-    pub fn advance_to(&mut self, t_end: f64, mut on_step: impl FnMut(&Self)) -> Result<(), Divergence> {
+    /// Steps until the time reaches `t_stop` (without shortening steps for it, so output
+    /// times never change the solution), shortening only the step that would pass `t_end`,
+    /// or until `on_step` (called after every step) returns false. Returns whether `t_stop`
+    /// was reached.
+    pub fn advance(
+        &mut self,
+        t_stop: f64,
+        t_end: f64,
+        mut on_step: impl FnMut(&Self) -> bool,
+    ) -> Result<bool, Divergence> {
+        let eps = 1e-12 * t_end.abs().max(1.0);
         loop {
             let remaining = t_end - self.state.time;
-            if remaining <= 1e-12 * t_end.abs().max(1.0) {
-                return Ok(());
+            if self.state.time >= t_stop - eps || remaining <= eps {
+                return Ok(true);
             }
             self.step(remaining)?;
-            on_step(self);
+            if !on_step(self) {
+                return Ok(false);
+            }
         }
     }
 

@@ -88,6 +88,16 @@ impl Series {
         Self { pvd, entries: Vec::new() }
     }
 
+    /// A series that already lists `entries` (when a run resumes).
+    pub fn with_entries(pvd: PathBuf, entries: Vec<(f64, String)>) -> Self {
+        Self { pvd, entries }
+    }
+
+    /// The snapshots listed so far: (time, file).
+    pub fn entries(&self) -> &[(f64, String)] {
+        &self.entries
+    }
+
     /// Adds a snapshot file (relative to the `.pvd`'s folder) at time `t`.
     pub fn push(&mut self, t: f64, file: &str) -> std::io::Result<()> {
         self.entries.push((t, file.to_string()));

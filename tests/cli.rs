@@ -1,0 +1,148 @@
+//! The command-line contract of `simulate`: bad input is refused with the key named and
+//! nothing written; a blow-up ends `diverged`, never `completed`, and never hangs.
+
+use std::path::Path;
+use std::process::Command;
+use std::time::{Duration, Instant};
+
+fn sphrepro(args: &[&str]) -> (i32, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_sphrepro")).args(args).output().expect("binary runs");
+    (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn simulate(dir: &Path, scene: &str, sets: &[&str]) -> (i32, String) {
+    let mut args = vec!["simulate", scene, "--quiet", "--out", dir.to_str().unwrap()];
+    for s in sets {
+        args.push("--set");
+        args.push(s);
+    }
+    sphrepro(&args)
+}
+
+#[test]
+fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
+    let cases: &[(&str, &[&str], &[&str])] = &[
+        ("taylor_green", &["nx=-5"], &["nx", "-5"]),
+        ("taylor_green", &["nx=0"], &["nx", "0"]),
+        ("taylor_green", &["nx=fifty"], &["nx", "fifty"]),
+        ("taylor_green", &["tf=0"], &["tf", "0"]),
+        ("taylor_green", &["hdx=0"], &["hdx", "0"]),
+        ("taylor_green", &["hdx=-1.5"], &["hdx", "-1.5"]),
+        ("taylor_green", &["re=0"], &["re", "0"]),
+        ("taylor_green", &["re=-100"], &["re", "-100"]),
+        ("taylor_green", &["frobnicate=3"], &["frobnicate", "3"]),
+        ("taylor_green", &["scheme=warp9"], &["scheme", "warp9"]),
+        ("taylor_green", &["pst=magic"], &["pst", "magic"]),
+        ("taylor_green", &["kernel=box"], &["kernel", "box"]),
+        ("taylor_green", &["corrections=some"], &["corrections", "some"]),
+        ("taylor_green", &["cfl=nan"], &["cfl", "NaN"]),
+        ("taylor_green", &["nx"], &["nx"]),
+        // A box too small for the kernel support is a parameter error, not a panic.
+        ("taylor_green", &["nx=4"], &["nx"]),
+        ("no_such_scene", &[], &["no_such_scene"]),
+    ];
+    for (scene, sets, words) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("run");
+        let (code, err) = simulate(&out, scene, sets);
+        assert_eq!(code, 2, "{scene} {sets:?}: exit {code}, stderr: {err}");
+        for w in *words {
+            assert!(err.contains(w), "{scene} {sets:?}: message does not name `{w}`: {err}");
+        }
+        assert_eq!(err.trim().lines().count(), 1, "one-line error: {err}");
+        assert!(!out.join("summary.json").exists(), "{scene} {sets:?} wrote a summary");
+    }
+}
+
+#[test]
+fn a_blow_up_ends_diverged_with_a_reason_and_a_non_zero_exit() {
+    let dir = tempfile::tempdir().unwrap();
+    let t0 = Instant::now();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "cfl=5", "tf=1.0"]);
+    assert!(t0.elapsed() < Duration::from_secs(60), "took {:?}", t0.elapsed());
+    assert_eq!(code, 3, "stderr: {err}");
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["status"], "diverged");
+    assert!(!s["reason"].as_str().unwrap().is_empty());
+    assert!(s["step"].as_u64().unwrap() > 0);
+    assert!(s["final_time"].as_f64().unwrap() < 1.0);
+    assert!(s["metrics"].as_object().unwrap().is_empty(), "a diverged run reports no metrics");
+}
+
+#[test]
+fn a_finished_run_is_not_overwritten_without_force() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "tf=0.02"]);
+    assert_eq!(code, 0, "{err}");
+    let before = std::fs::read(dir.path().join("summary.json")).unwrap();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "tf=0.04"]);
+    assert_eq!(code, 2);
+    assert!(err.contains("--force"), "{err}");
+    assert_eq!(std::fs::read(dir.path().join("summary.json")).unwrap(), before);
+    let dir_s = dir.path().to_str().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_sphrepro"))
+        .args([
+            "simulate",
+            "taylor_green",
+            "--quiet",
+            "--force",
+            "--set",
+            "nx=16",
+            "--set",
+            "tf=0.04",
+            "--out",
+            dir_s,
+        ])
+        .status()
+        .unwrap();
+    assert!(out.success());
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["params"]["tf"], 0.04);
+}
+
+#[test]
+fn a_completed_run_writes_the_contracted_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "tf=0.05", "scheme=ctvf", "pst=ipst"]);
+    assert_eq!(code, 0, "{err}");
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    for k in [
+        "scene",
+        "params",
+        "particles",
+        "steps",
+        "final_time",
+        "wall_seconds",
+        "particle_steps_per_second",
+        "threads",
+        "status",
+        "provenance",
+    ] {
+        assert!(s.get(k).is_some(), "summary lacks {k}");
+    }
+    assert_eq!(s["status"], "completed");
+    assert_eq!(s["particles"], 256);
+    assert!((s["final_time"].as_f64().unwrap() - 0.05).abs() < 1e-12);
+    for m in [
+        "l1_velocity_final",
+        "l1_velocity_max",
+        "umax_decay_rel_error",
+        "p_l1_final",
+        "kinetic_energy_rel_error",
+    ] {
+        assert!(s["metrics"][m].as_f64().unwrap().is_finite(), "metric {m}");
+    }
+    for k in ["version", "git_commit", "rustc", "host", "started", "finished"] {
+        assert!(s["provenance"][k].is_string(), "provenance lacks {k}");
+    }
+    let ts = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
+    assert!(ts.lines().next().unwrap().starts_with("t,u_max,u_max_exact,l1_velocity"));
+    assert!(ts.lines().count() > 10);
+    let pvd = std::fs::read_to_string(dir.path().join("fluid.pvd")).unwrap();
+    let n = pvd.matches("<DataSet").count();
+    assert_eq!(n, 11, "snapshots at 0, tf/10, ..., tf");
+    assert!(dir.path().join("vtu/fluid_00010.vtu").exists());
+}
