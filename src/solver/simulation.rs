@@ -52,6 +52,8 @@ pub struct State<const D: usize> {
     pub u_max: f64,
     /// The scheme, with quantities measured at the start (IPST chi_ref).
     pub scheme: FluidScheme,
+    /// IPST moves in the last step (a diagnostic written to the time series).
+    pub ipst_iterations: usize,
 }
 
 /// One simulation of one fluid body in a domain.
@@ -98,7 +100,7 @@ impl<const D: usize> Simulation<D> {
             scheme.density == DensityModel::Continuity,
             transport,
         );
-        let mut state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme };
+        let mut state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme, ipst_iterations: 0 };
         let mut neighbours = KernelList::new();
         Self::rebuild(&domain, &kernel, &mut cells, &mut neighbours, &mut state.fluid);
         if let Some(t) = scheme.transport.as_mut() {
@@ -154,7 +156,7 @@ impl<const D: usize> Simulation<D> {
 
     /// IPST iterations in the last step.
     pub fn last_ipst_iterations(&self) -> usize {
-        self.passes.last_ipst_iterations
+        self.state.ipst_iterations
     }
 
     /// Wraps positions into the box, sorts the particles by cell and lists neighbours.
@@ -190,7 +192,14 @@ impl<const D: usize> Simulation<D> {
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
         let st = &mut self.state;
         self.passes.accelerations(&st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt_nominal);
-        self.passes.ipst(&st.fluid, &self.neighbours, &self.kernel, &st.scheme, &mut st.rates, dt_nominal);
+        st.ipst_iterations = self.passes.ipst(
+            &st.fluid,
+            &self.neighbours,
+            &self.kernel,
+            &st.scheme,
+            &mut st.rates,
+            dt_nominal,
+        );
     }
 
     /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60).

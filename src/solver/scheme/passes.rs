@@ -63,20 +63,12 @@ pub struct FluidPasses<const D: usize> {
     dr: Vec<Vector<D>>,
     chi: Vec<f64>,
     points: Vec<Point<D>>,
-    /// IPST iterations taken in the last step (for logs and benchmarks).
-    pub last_ipst_iterations: usize,
 }
 
 impl<const D: usize> FluidPasses<D> {
     /// Empty work space; the arrays grow on first use (IPST's only when it is declared).
     pub fn new() -> Self {
-        Self {
-            x_shift: Vec::new(),
-            dr: Vec::new(),
-            chi: Vec::new(),
-            points: Vec::new(),
-            last_ipst_iterations: 0,
-        }
+        Self { x_shift: Vec::new(), dr: Vec::new(), chi: Vec::new(), points: Vec::new() }
     }
 
     /// Summation density, `rho_a = sum_b m_b W_ab`.
@@ -274,6 +266,7 @@ impl<const D: usize> FluidPasses<D> {
     /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
     /// are those entering the support from outside it during the iterations, whose kernel
     /// value is of the fifth order in the distance they moved in (quintic spline).
+    /// Returns the number of moves made.
     pub fn ipst(
         &mut self,
         fluid: &Fluid<D>,
@@ -282,9 +275,9 @@ impl<const D: usize> FluidPasses<D> {
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
-    ) {
+    ) -> usize {
         let Some(Shifting::Ipst { u_max, tol, max_iter, chi_ref }) = s.transport.map(|t| t.shifting) else {
-            return;
+            return 0;
         };
         let k = k.scaled(fluid.h);
         let n = fluid.len();
@@ -319,12 +312,12 @@ impl<const D: usize> FluidPasses<D> {
             }
             iterations += 1;
         }
-        self.last_ipst_iterations = iterations;
         let f = 2.0 / (dt * dt);
         let (x0, xs) = (&fluid.x, &self.x_shift);
         rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
             *ac = (xs[i] - x0[i]) * f;
         });
+        iterations
     }
 }
 
