@@ -278,13 +278,22 @@ mod tests {
         let clear = |i: usize, v: &[usize]| -> Vec<usize> {
             v.iter()
                 .copied()
-                .filter(|&j| (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius)
+                .filter(|&j| {
+                    (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius
+                })
                 .collect()
         };
         for i in 0..points.len() {
-            assert_eq!(clear(i, &brute[i]), clear(i, &cells[i]), "point {i}, radius {radius}, domain {domain:?}");
+            assert_eq!(
+                clear(i, &brute[i]),
+                clear(i, &cells[i]),
+                "point {i}, radius {radius}, domain {domain:?}"
+            );
         }
-        assert!(brute.iter().map(|v| v.len()).sum::<usize>() > points.len(), "test has pairs");
+        assert!(
+            brute.iter().map(|v| v.len()).sum::<usize>() > points.len(),
+            "test has pairs"
+        );
     }
 
     #[test]
