@@ -19,3 +19,4 @@ pub mod lock;
 pub mod registry;
 pub mod report;
 pub mod runner;
+pub mod study;

@@ -203,8 +203,11 @@ pub enum FigureKind {
         field: String,
     },
     /// Error against cost (wall time and particle-steps) with the Pareto front, and the
-    /// same as a table with the observed orders of convergence.
-    Trade,
+    /// same as a table with the observed orders of convergence along `x`.
+    Trade {
+        /// The resolution parameter (e.g. `nx`); h is taken as `1 / x`.
+        x: String,
+    },
     /// Outcome map (stable / inaccurate / diverged) of the curve groups against parameter
     /// `x`, and the same as a table.
     Stability {
@@ -779,7 +782,11 @@ fn expand(
             },
             "trade" => {
                 need("metric", &f.metric)?;
-                FigureKind::Trade
+                let x = need("x", &f.x)?;
+                if !specs.iter().any(|s| s.name == x) {
+                    return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
+                }
+                FigureKind::Trade { x }
             }
             "stability" => {
                 need("metric", &f.metric)?;
