@@ -169,7 +169,11 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
 
 /// Figures, tables and (with `flags.manuscript`) manuscript.md from cached results.
 fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(), String> {
-    if problems.iter().all(|p| p.figures.is_empty() && p.tables.is_empty()) && !flags.manuscript {
+    if problems
+        .iter()
+        .all(|p| p.figures.is_empty() && p.tables.is_empty())
+        && !flags.manuscript
+    {
         return Ok(());
     }
     ensure_dir(&dirs.manuscript, "manuscript")?;
