@@ -160,7 +160,7 @@ scene = "taylor_green"
 [presets.quick]
 [[cases]]
 name = "a"
-params = { nx = 16, tf = 3.0 }
+params = { nx = 16, tf = 20.0 }
 "#,
     );
     let mut child = env
@@ -188,7 +188,7 @@ params = { nx = 16, tf = 3.0 }
     };
     let pgid = child.id();
     Command::new("kill")
-        .args(["-KILL", &format!("-{pgid}")])
+        .args(["-KILL", "--", &format!("-{pgid}")])
         .status()
         .unwrap();
     let _ = child.wait();
@@ -212,8 +212,14 @@ params = { nx = 16, tf = 3.0 }
 #[test]
 fn two_runs_at_once_simulate_each_case_once() {
     let env = Env::new(&three_cases(0.3).replace("BOUND", "1.0"));
-    let a = env.cmd(&["run", "tiny"]).spawn().unwrap();
-    let b = env.cmd(&["run", "tiny"]).spawn().unwrap();
+    let spawn = || {
+        env.cmd(&["run", "tiny"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (a, b) = (spawn(), spawn());
     let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
     assert!(
         a.status.success() && b.status.success(),
@@ -304,7 +310,8 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
     for (what, from, to, word) in bad {
         assert!(VALID.contains(from), "{what}");
         let src = VALID.replacen(from, to, 1);
-        let line = src[..src.find(to).unwrap()].matches('\n').count() + 1;
+        let end = src.find(to).unwrap() + to.len();
+        let line = src[..end].matches('\n').count() + 1;
         let env = Env::new(&src);
         let o = env.run(&["run", "tiny"]);
         let t = text(&o);
