@@ -20,3 +20,33 @@ pub mod registry;
 pub mod report;
 pub mod runner;
 pub mod study;
+
+#[cfg(test)]
+mod tests {
+    /// STYLE 6.9: the solver never imports the scenes or the automation half.
+    #[test]
+    fn solver_does_not_depend_on_scenes_or_automation() {
+        fn walk(dir: &std::path::Path, bad: &mut Vec<String>) {
+            for e in std::fs::read_dir(dir).unwrap().flatten() {
+                let p = e.path();
+                if p.is_dir() {
+                    walk(&p, bad);
+                } else if p.extension().is_some_and(|x| x == "rs") {
+                    let s = std::fs::read_to_string(&p).unwrap();
+                    if s.contains("crate::scenes") || s.contains("crate::automation") {
+                        bad.push(p.display().to_string());
+                    }
+                }
+            }
+        }
+        let mut bad = Vec::new();
+        walk(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/solver"),
+            &mut bad,
+        );
+        assert!(
+            bad.is_empty(),
+            "solver files importing scenes/automation: {bad:?}"
+        );
+    }
+}
