@@ -12,6 +12,7 @@
 
 #![deny(missing_docs)]
 
+pub mod automation;
 pub mod bench;
 pub mod scenes;
 pub mod solver;

@@ -1,6 +1,8 @@
 //! The `sphrepro` command line. Thin: every command calls into the library.
 
-use clap::{Parser, Subcommand};
+use clap::{Args, Parser, Subcommand};
+use sphrepro::automation::commands::{self, Dirs, RunFlags};
+use sphrepro::automation::runner;
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
 use std::path::PathBuf;
@@ -17,10 +19,106 @@ struct Cli {
     command: Command,
 }
 
+/// Where problems, results and the manuscript live.
+#[derive(Args, Clone)]
+struct DirArgs {
+    /// Folder of problem files (*.toml).
+    #[arg(long, default_value = "problems")]
+    problems: PathBuf,
+    /// Folder of results (one sub-folder per problem and case).
+    #[arg(long, default_value = "output")]
+    output: PathBuf,
+    /// Folder of figures/, tables/ and manuscript.md.
+    #[arg(long, default_value = "manuscript")]
+    manuscript: PathBuf,
+}
+
+impl DirArgs {
+    fn dirs(&self) -> Dirs {
+        Dirs {
+            problems: self.problems.clone(),
+            output: self.output.clone(),
+            manuscript: self.manuscript.clone(),
+        }
+    }
+}
+
+/// Options of `run` and `reproduce`.
+#[derive(Args, Clone)]
+struct RunArgs {
+    /// Preset: quick (minutes, the default) or paper (the published resolutions).
+    #[arg(long, default_value = "quick")]
+    preset: String,
+    /// Only cases whose name (or problem/name) matches this glob.
+    #[arg(long = "match", value_name = "GLOB")]
+    matching: Option<String>,
+    /// Re-run cases that are done.
+    #[arg(long)]
+    force: bool,
+    /// Concurrent cases (default: the core count; cores are split between cases and threads).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Print what would run and why; run nothing.
+    #[arg(long)]
+    dry_run: bool,
+    /// Regenerate figures and tables from cached results without simulating.
+    #[arg(long)]
+    plot_only: bool,
+    #[command(flatten)]
+    dirs: DirArgs,
+}
+
+impl RunArgs {
+    fn options(&self) -> runner::Options {
+        runner::Options {
+            jobs: self.jobs,
+            force: self.force,
+            matching: self.matching.clone(),
+            dry_run: self.dry_run,
+            checkpoint_every: Some(30.0),
+        }
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
-    /// List the scenes and their parameters.
-    List,
+    /// List the problems and their cases, then the scenes and their parameters.
+    List {
+        /// Preset whose cases are listed.
+        #[arg(long, default_value = "quick")]
+        preset: String,
+        #[command(flatten)]
+        dirs: DirArgs,
+    },
+    /// Run problems (cases that are missing, failed or stale), then their figures and tables.
+    Run {
+        /// Problem names (file stems under --problems).
+        #[arg(required = true)]
+        problem: Vec<String>,
+        #[command(flatten)]
+        args: RunArgs,
+    },
+    /// Every problem, every figure and table, and manuscript.md.
+    Reproduce {
+        #[command(flatten)]
+        args: RunArgs,
+    },
+    /// Done, missing, stale and failed cases.
+    Status {
+        /// Preset.
+        #[arg(long, default_value = "quick")]
+        preset: String,
+        #[command(flatten)]
+        dirs: DirArgs,
+    },
+    /// Compare every bound of the problem files with the cached results (for CI).
+    Check {
+        /// Preset.
+        #[arg(long, default_value = "quick")]
+        preset: String,
+        #[command(flatten)]
+        dirs: DirArgs,
+    },
     /// Run one simulation, no cache: writes DIR/summary.json, timeseries.csv and snapshots.
     Simulate {
         /// Scene name (see `list`).
@@ -92,7 +190,12 @@ fn main() -> ExitCode {
         }
     });
     match cli.command {
-        Command::List => {
+        Command::List { preset, dirs } => {
+            let code = commands::list(&dirs.dirs(), &preset);
+            if code != 0 {
+                return ExitCode::from(code);
+            }
+            println!("scenes:");
             for s in scenes::SCENES {
                 println!("{} ({}D): {}", s.name, s.dim, s.about);
                 for p in (s.params)() {
@@ -108,6 +211,28 @@ fn main() -> ExitCode {
             }
             ExitCode::SUCCESS
         }
+        Command::Run { problem, args } => ExitCode::from(commands::run(
+            &args.dirs.dirs(),
+            &args.preset,
+            &problem,
+            &args.options(),
+            &RunFlags {
+                plot_only: args.plot_only,
+                manuscript: false,
+            },
+        )),
+        Command::Reproduce { args } => ExitCode::from(commands::run(
+            &args.dirs.dirs(),
+            &args.preset,
+            &[],
+            &args.options(),
+            &RunFlags {
+                plot_only: args.plot_only,
+                manuscript: true,
+            },
+        )),
+        Command::Status { preset, dirs } => ExitCode::from(commands::status(&dirs.dirs(), &preset)),
+        Command::Check { preset, dirs } => ExitCode::from(commands::check(&dirs.dirs(), &preset)),
         Command::Simulate {
             scene,
             sets,

@@ -304,7 +304,9 @@ mod tests {
         let clear = |i: usize, v: &[usize]| -> Vec<usize> {
             v.iter()
                 .copied()
-                .filter(|&j| (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius)
+                .filter(|&j| {
+                    (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius
+                })
                 .collect()
         };
         for i in 0..points.len() {
@@ -314,7 +316,10 @@ mod tests {
                 "point {i}, radius {radius}, domain {domain:?}"
             );
         }
-        assert!(brute.iter().map(|v| v.len()).sum::<usize>() > points.len(), "test has pairs");
+        assert!(
+            brute.iter().map(|v| v.len()).sum::<usize>() > points.len(),
+            "test has pairs"
+        );
     }
 
     #[test]

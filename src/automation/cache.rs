@@ -1,0 +1,238 @@
+//! The result cache: one folder per case, `OUTPUT/<problem>/<case>-<first 10 hex of key>/`,
+//! keyed by a sha2 digest of the scene, the resolved parameters (canonical JSON) and the
+//! solver fingerprint. A case is done when its `summary.json` (written atomically by
+//! `simulate`) says `completed` or `diverged`; `case.json` beside it keeps the inputs, so
+//! a stale folder can say which input changed.
+
+use super::registry::{Case, Problem};
+use crate::solver::output::summary::{Status, Summary, SCHEME_VERSION};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The solver fingerprint in every key: crate version and scheme version.
+pub fn fingerprint() -> String {
+    format!("{}+scheme{}", env!("CARGO_PKG_VERSION"), SCHEME_VERSION)
+}
+
+/// The inputs of a case, written to `case.json` in its folder.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CaseRecord {
+    /// Problem name.
+    pub problem: String,
+    /// Case name.
+    pub name: String,
+    /// Scene.
+    pub scene: String,
+    /// Resolved parameters.
+    pub params: BTreeMap<String, serde_json::Value>,
+    /// Solver fingerprint.
+    pub solver: String,
+    /// The full key (hex sha256).
+    pub key: String,
+}
+
+impl CaseRecord {
+    /// The record of `case` of `problem` for this binary.
+    pub fn new(problem: &str, case: &Case) -> Self {
+        let params = case.params.to_json();
+        let solver = fingerprint();
+        let canonical = serde_json::json!({
+            "scene": case.scene,
+            "params": params,
+            "solver": solver,
+        });
+        let digest = Sha256::digest(canonical.to_string().as_bytes());
+        let key = digest.iter().map(|b| format!("{b:02x}")).collect();
+        Self {
+            problem: problem.into(),
+            name: case.name.clone(),
+            scene: case.scene.clone(),
+            params,
+            solver,
+            key,
+        }
+    }
+
+    /// Folder name: `<case>-<first 10 hex of key>`.
+    pub fn folder(&self) -> String {
+        format!("{}-{}", self.name, &self.key[..10])
+    }
+
+    /// What differs between `old` (a record found on disk) and this one, in words.
+    pub fn changes_from(&self, old: &CaseRecord) -> String {
+        let mut out = Vec::new();
+        if old.scene != self.scene {
+            out.push(format!("scene {} -> {}", old.scene, self.scene));
+        }
+        if old.solver != self.solver {
+            out.push(format!("solver {} -> {}", old.solver, self.solver));
+        }
+        let keys: std::collections::BTreeSet<&String> =
+            old.params.keys().chain(self.params.keys()).collect();
+        for k in keys {
+            let (a, b) = (old.params.get(k), self.params.get(k));
+            if a != b {
+                let show = |v: Option<&serde_json::Value>| {
+                    v.map(|v| v.to_string()).unwrap_or_else(|| "(none)".into())
+                };
+                out.push(format!("{k} {} -> {}", show(a), show(b)));
+            }
+        }
+        if out.is_empty() {
+            "unchanged inputs".into()
+        } else {
+            out.join(", ")
+        }
+    }
+}
+
+/// State of a case in the cache.
+#[derive(Clone, Debug, PartialEq)]
+pub enum State {
+    /// A `completed` or `diverged` summary.
+    Done(Status),
+    /// A folder with a `failed` summary, or none (killed, crashed).
+    Failed(String),
+    /// No folder. If a folder of the same case name with another key exists, the change.
+    Missing(Option<String>),
+}
+
+/// A case with its place in the cache.
+#[derive(Clone, Debug)]
+pub struct Entry {
+    /// The case.
+    pub case: Case,
+    /// Its inputs and key.
+    pub record: CaseRecord,
+    /// Its folder.
+    pub dir: PathBuf,
+}
+
+impl Entry {
+    /// The cache entry of `case` of `problem` under `output`.
+    pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
+        let record = CaseRecord::new(&problem.name, case);
+        let dir = output.join(&problem.name).join(record.folder());
+        Self {
+            case: case.clone(),
+            record,
+            dir,
+        }
+    }
+
+    /// The summary, if there is a readable one.
+    pub fn summary(&self) -> Option<Summary> {
+        Summary::read(&self.dir).ok()
+    }
+
+    /// The state of this case on disk.
+    pub fn state(&self) -> State {
+        match Summary::read(&self.dir) {
+            Ok(s) if matches!(s.status, Status::Completed | Status::Diverged) => {
+                State::Done(s.status)
+            }
+            Ok(s) => State::Failed(s.reason.unwrap_or_else(|| "failed".into())),
+            Err(_) if self.dir.exists() => {
+                State::Failed("no summary: the run was killed or crashed".into())
+            }
+            Err(_) => State::Missing(self.previous_change()),
+        }
+    }
+
+    /// Whether the case is done.
+    pub fn is_done(&self) -> bool {
+        matches!(self.state(), State::Done(_))
+    }
+
+    /// If another folder holds this case name with another key, what changed.
+    fn previous_change(&self) -> Option<String> {
+        let parent = self.dir.parent()?;
+        let mut found = None;
+        for e in std::fs::read_dir(parent).ok()?.flatten() {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let Some((case, _)) = name.rsplit_once('-') else {
+                continue;
+            };
+            if case != self.record.name || e.path() == self.dir {
+                continue;
+            }
+            if let Some(old) = read_record(&e.path()) {
+                found = Some(self.record.changes_from(&old));
+            }
+        }
+        found
+    }
+
+    /// Writes `case.json` (creating the folder).
+    pub fn write_record(&self) -> Result<(), String> {
+        std::fs::create_dir_all(&self.dir)
+            .map_err(|e| format!("{}: cannot create the case folder: {e}", self.dir.display()))?;
+        let path = self.dir.join("case.json");
+        let json = serde_json::to_string_pretty(&self.record).expect("record serialises");
+        crate::solver::output::write_atomic(&path, json.as_bytes())
+            .map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+/// Reads `DIR/case.json`.
+pub fn read_record(dir: &Path) -> Option<CaseRecord> {
+    let s = std::fs::read_to_string(dir.join("case.json")).ok()?;
+    serde_json::from_str(&s).ok()
+}
+
+/// Every case of `problem` with its cache entry.
+pub fn entries(output: &Path, problem: &Problem) -> Vec<Entry> {
+    problem
+        .cases
+        .iter()
+        .map(|c| Entry::new(output, problem, c))
+        .collect()
+}
+
+/// Folders under `OUTPUT/<problem>/` that belong to no case of `problems` (in any of the
+/// given presets' expansions): results of changed inputs. Reported, never deleted.
+pub fn stale_folders(output: &Path, problem: &str, live: &[PathBuf]) -> Vec<PathBuf> {
+    let dir = output.join(problem);
+    let Ok(rd) = std::fs::read_dir(&dir) else {
+        return Vec::new();
+    };
+    let mut out: Vec<PathBuf> = rd
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir() && !live.contains(p))
+        .collect();
+    out.sort();
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenes::params::{Params, Value};
+
+    fn case(nx: i64) -> Case {
+        let entry = crate::scenes::find("taylor_green").unwrap();
+        let mut p = Params::defaults(&(entry.params)());
+        p.0.insert("nx".into(), Value::Int(nx));
+        Case {
+            name: "a".into(),
+            scene: "taylor_green".into(),
+            params: p,
+        }
+    }
+
+    #[test]
+    fn key_depends_on_parameters_only() {
+        let (a, b, c) = (
+            CaseRecord::new("p", &case(16)),
+            CaseRecord::new("p", &case(16)),
+            CaseRecord::new("p", &case(20)),
+        );
+        assert_eq!(a.key, b.key);
+        assert_ne!(a.key, c.key);
+        assert_eq!(c.changes_from(&a), "nx 16 -> 20");
+        assert!(a.folder().starts_with("a-") && a.folder().len() == 12);
+    }
+}

@@ -1,0 +1,155 @@
+//! `check` and `status`: the bounds of the problem files against the cached results, and
+//! the state of every case.
+
+use super::cache::{self, State};
+use super::registry::Problem;
+use std::path::Path;
+
+/// One bound checked against one case.
+#[derive(Debug)]
+pub struct Breach {
+    /// `problem/case`.
+    pub case: String,
+    /// What went wrong, naming metric, value and bound.
+    pub what: String,
+}
+
+/// Checks every bound of `problems` against the results under `output`. Returns the
+/// number of (bound, case) pairs that hold and every breach; a missing or unfinished
+/// result is a breach.
+pub fn check(output: &Path, problems: &[Problem]) -> (usize, Vec<Breach>) {
+    let mut ok = 0;
+    let mut bad = Vec::new();
+    for p in problems {
+        for b in &p.bounds {
+            for c in b.select.pick(&p.cases) {
+                let e = cache::Entry::new(output, p, c);
+                let case = format!("{}/{}", p.name, c.name);
+                let at = format!("{}:{}", p.path.display(), b.line);
+                let s = match (e.state(), e.summary()) {
+                    (State::Done(_), Some(s)) => s,
+                    (state, _) => {
+                        bad.push(Breach {
+                            case,
+                            what: format!(
+                                "{}: no result ({}) for the bound on line {at}",
+                                b.metric,
+                                state_word(&state)
+                            ),
+                        });
+                        continue;
+                    }
+                };
+                let Some(v) = s.metrics.get(&b.metric).copied() else {
+                    bad.push(Breach {
+                        case,
+                        what: format!(
+                            "{} missing: status {:?}, reason {} ({at})",
+                            b.metric,
+                            s.status,
+                            s.reason.unwrap_or_default()
+                        ),
+                    });
+                    continue;
+                };
+                let mut fail = None;
+                if let Some(max) = b.max {
+                    if v.is_nan() || v > max {
+                        fail = Some(format!("{} = {v:.6e} > max {max:e} ({at})", b.metric));
+                    }
+                }
+                if let Some(min) = b.min {
+                    if v.is_nan() || v < min {
+                        fail = Some(format!("{} = {v:.6e} < min {min:e} ({at})", b.metric));
+                    }
+                }
+                match fail {
+                    Some(what) => bad.push(Breach { case, what }),
+                    None => ok += 1,
+                }
+            }
+        }
+    }
+    (ok, bad)
+}
+
+/// A word for a state.
+pub fn state_word(s: &State) -> String {
+    match s {
+        State::Done(st) => serde_json::to_value(st)
+            .ok()
+            .and_then(|v| v.as_str().map(String::from))
+            .unwrap_or_else(|| "done".into()),
+        State::Failed(r) => format!("failed: {r}"),
+        State::Missing(Some(c)) => format!("stale: {c}"),
+        State::Missing(None) => "missing".into(),
+    }
+}
+
+/// Counts of case states.
+#[derive(Debug, Default)]
+pub struct StatusCounts {
+    /// Completed or diverged.
+    pub done: usize,
+    /// Failed or killed.
+    pub failed: usize,
+    /// Never run, or run with other inputs.
+    pub missing: usize,
+    /// Folders that belong to no current case.
+    pub stale_folders: usize,
+}
+
+/// Prints the state of every case of `problems` (and the stale folders) to stdout.
+pub fn status(output: &Path, problems: &[Problem]) -> StatusCounts {
+    let mut n = StatusCounts::default();
+    for p in problems {
+        println!("{} ({}, preset {}):", p.name, p.title, p.preset);
+        let entries = cache::entries(output, p);
+        for e in &entries {
+            let st = e.state();
+            match st {
+                State::Done(_) => n.done += 1,
+                State::Failed(_) => n.failed += 1,
+                State::Missing(_) => n.missing += 1,
+            }
+            let running = super::lock::Lock::path_for(&e.dir).exists();
+            println!(
+                "  {:<10} {}{}",
+                match st {
+                    State::Done(_) => "done",
+                    State::Failed(_) if running => "running",
+                    State::Failed(_) => "failed",
+                    State::Missing(Some(_)) => "stale",
+                    State::Missing(None) => "missing",
+                },
+                e.case.name,
+                match &st {
+                    State::Done(_) => format!("  ({})", state_word(&st)),
+                    State::Failed(r) => format!("  ({r}; log {})", e.dir.join("run.log").display()),
+                    State::Missing(Some(c)) => format!("  (inputs changed: {c})"),
+                    State::Missing(None) => String::new(),
+                }
+            );
+        }
+        let live: Vec<_> = entries.iter().map(|e| e.dir.clone()).collect();
+        for s in cache::stale_folders(output, &p.name, &live) {
+            n.stale_folders += 1;
+            let why = cache::read_record(&s)
+                .map(|r| match entries.iter().find(|e| e.record.name == r.name) {
+                    Some(e) => format!("case {} now has {}", r.name, e.record.changes_from(&r)),
+                    None => format!("case {} is no longer in the problem file", r.name),
+                })
+                .unwrap_or_else(|| "no case.json".into());
+            println!(
+                "  {:<10} {}  ({why}; kept, not deleted)",
+                "stale",
+                s.display()
+            );
+        }
+    }
+    println!(
+        "{} done, {} failed, {} missing, {} stale folder(s)",
+        n.done, n.failed, n.missing, n.stale_folders
+    );
+    n
+}

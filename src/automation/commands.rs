@@ -1,0 +1,261 @@
+//! The automation commands behind `sphrepro list | run | reproduce | status | check`; each
+//! returns the process exit status.
+
+use super::registry::{self, Problem};
+use super::runner::{self, Options};
+use super::{cache, check};
+use std::path::{Path, PathBuf};
+
+/// Folders every automation command reads or writes.
+#[derive(Clone, Debug)]
+pub struct Dirs {
+    /// Problem files.
+    pub problems: PathBuf,
+    /// Results.
+    pub output: PathBuf,
+    /// Figures, tables and manuscript.md.
+    pub manuscript: PathBuf,
+}
+
+/// Exit status: success.
+pub const OK: u8 = 0;
+/// Exit status: a case failed, a bound was breached, an I/O error.
+pub const FAILED: u8 = 1;
+/// Exit status: invalid problem files or arguments; nothing ran.
+pub const BAD_INPUT: u8 = 2;
+/// Exit status: interrupted by Ctrl-C.
+pub const INTERRUPTED: u8 = 130;
+
+/// Loads every problem of `dirs.problems` (all are validated), keeping those named in
+/// `only` (all if empty).
+fn load(dirs: &Dirs, preset: &str, only: &[String]) -> Result<Vec<Problem>, String> {
+    let all = registry::load_dir(&dirs.problems, preset)?;
+    for name in only {
+        if !all.iter().any(|p| &p.name == name) {
+            let known: Vec<_> = all.iter().map(|p| p.name.as_str()).collect();
+            return Err(format!(
+                "no problem `{name}` in {}; problems: {}",
+                dirs.problems.display(),
+                known.join(", ")
+            ));
+        }
+    }
+    Ok(all
+        .into_iter()
+        .filter(|p| only.is_empty() || only.contains(&p.name))
+        .collect())
+}
+
+/// `list`: problems and their cases.
+pub fn list(dirs: &Dirs, preset: &str) -> u8 {
+    match load(dirs, preset, &[]) {
+        Ok(ps) => {
+            for p in &ps {
+                println!(
+                    "{} ({}): {} case(s) in preset {}, scene {}",
+                    p.name,
+                    p.title,
+                    p.cases.len(),
+                    p.preset,
+                    p.scene.name
+                );
+                for c in &p.cases {
+                    println!("    {}", c.name);
+                }
+            }
+            OK
+        }
+        Err(e) if !dirs.problems.exists() => {
+            println!("(no problems: {e})");
+            OK
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            BAD_INPUT
+        }
+    }
+}
+
+/// Creates the output folder, or says why it cannot.
+fn ensure_dir(dir: &Path, what: &str) -> Result<(), String> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| format!("cannot create the {what} folder {}: {e}", dir.display()))?;
+    let probe = dir.join(format!(".write-probe-{}", std::process::id()));
+    std::fs::write(&probe, b"")
+        .map_err(|e| format!("cannot write in the {what} folder {}: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(probe);
+    Ok(())
+}
+
+/// What `run` and `reproduce` do besides simulating.
+#[derive(Clone, Debug, Default)]
+pub struct RunFlags {
+    /// Regenerate figures from cached results only.
+    pub plot_only: bool,
+    /// Also write manuscript.md.
+    pub manuscript: bool,
+}
+
+/// `run` (and `reproduce` with every problem): simulate what is missing or stale, then
+/// regenerate the figures and tables of the problems.
+pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &RunFlags) -> u8 {
+    let problems = match load(dirs, preset, only) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return BAD_INPUT;
+        }
+    };
+    let mut status = OK;
+    if !flags.plot_only {
+        let (tasks, done) = match runner::plan(&dirs.output, &problems, opts) {
+            Ok(t) => t,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return BAD_INPUT;
+            }
+        };
+        if opts.dry_run {
+            for t in &tasks {
+                println!(
+                    "would run {}/{} ({})  -> {}",
+                    t.problem,
+                    t.entry.case.name,
+                    t.reason,
+                    t.entry.dir.display()
+                );
+            }
+            println!("{} to run, {done} done (skipped)", tasks.len());
+            return OK;
+        }
+        if let Err(e) = ensure_dir(&dirs.output, "output") {
+            eprintln!("error: {e}");
+            return FAILED;
+        }
+        println!("{} case(s) to run, {done} done (skipped)", tasks.len());
+        let report = match runner::execute(tasks, opts) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("error: {e}");
+                return FAILED;
+            }
+        };
+        if report.interrupted {
+            eprintln!("interrupted: running cases were stopped and are not done");
+            status = INTERRUPTED;
+        }
+        if !report.failures.is_empty() {
+            eprintln!("{} case(s) failed:", report.failures.len());
+            for (case, log, why) in &report.failures {
+                eprintln!("  {case}: {why}\n    log: {}", log.display());
+            }
+            if status == OK {
+                status = FAILED;
+            }
+        }
+        if report.interrupted {
+            return status;
+        }
+    } else if opts.dry_run {
+        println!("(--plot-only: nothing would be simulated)");
+        return OK;
+    }
+    if let Err(e) = post_process(dirs, &problems, flags) {
+        eprintln!("error: {e}");
+        return FAILED;
+    }
+    status
+}
+
+/// Figures, tables and (with `flags.manuscript`) manuscript.md from cached results.
+fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(), String> {
+    if problems
+        .iter()
+        .all(|p| p.figures.is_empty() && p.tables.is_empty())
+        && !flags.manuscript
+    {
+        return Ok(());
+    }
+    ensure_dir(&dirs.manuscript, "manuscript")?;
+    let mut sections = Vec::new();
+    for p in problems {
+        sections.push(super::study::regenerate(p, &dirs.output, &dirs.manuscript)?);
+        println!(
+            "{}: {} figure(s), {} table(s) in {}",
+            p.name,
+            p.figures.len(),
+            p.tables.len(),
+            dirs.manuscript.display()
+        );
+    }
+    if flags.manuscript {
+        let path = dirs.manuscript.join("manuscript.md");
+        super::report::write_manuscript(
+            &super::report::Manuscript {
+                title: "sphrepro: regenerated results".into(),
+                intro: format!(
+                    "Every figure and table below was regenerated by `sphrepro reproduce --preset {}` \
+                     from the problem files in `problems/` and the cached results; each figure says what \
+                     the paper shows and what this run got. Solver fingerprint {}.",
+                    problems.first().map(|p| p.preset.as_str()).unwrap_or("quick"),
+                    super::cache::fingerprint()
+                ),
+                sections,
+            },
+            &path,
+        )?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// `status`: every case's state and the stale folders. Exits 1 if any case is not done.
+pub fn status(dirs: &Dirs, preset: &str) -> u8 {
+    match load(dirs, preset, &[]) {
+        Ok(ps) => {
+            let n = check::status(&dirs.output, &ps);
+            if n.failed + n.missing == 0 {
+                OK
+            } else {
+                FAILED
+            }
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            BAD_INPUT
+        }
+    }
+}
+
+/// `check`: every bound of the preset against the cached results.
+pub fn check(dirs: &Dirs, preset: &str) -> u8 {
+    let ps = match load(dirs, preset, &[]) {
+        Ok(p) => p,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return BAD_INPUT;
+        }
+    };
+    let (ok, bad) = check::check(&dirs.output, &ps);
+    for b in &bad {
+        println!("FAIL {}: {}", b.case, b.what);
+    }
+    println!(
+        "{ok} bound(s) hold, {} breached (preset {preset})",
+        bad.len()
+    );
+    if bad.is_empty() {
+        OK
+    } else {
+        FAILED
+    }
+}
+
+/// The cache folder of every case (for tests and tools).
+pub fn case_dirs(dirs: &Dirs, preset: &str) -> Result<Vec<PathBuf>, String> {
+    let ps = load(dirs, preset, &[])?;
+    Ok(ps
+        .iter()
+        .flat_map(|p| cache::entries(&dirs.output, p).into_iter().map(|e| e.dir))
+        .collect())
+}

@@ -1,0 +1,1057 @@
+//! The problem registry: reads `problems/*.toml`, checks every entry against the scene's
+//! declared parameters and metrics, and expands parameter grids into named cases for a
+//! preset. Every error names the file, the line and the key; nothing runs unless every
+//! problem file is valid. The schema is documented in `docs/problems.md`.
+
+use crate::scenes::params::{Params, Spec, Value};
+use crate::scenes::{self, SceneEntry};
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// The preset used when none is named.
+pub const DEFAULT_PRESET: &str = "quick";
+
+/// A map of parameter values as written in a problem file.
+type RawParams = BTreeMap<String, Spanned<toml::Value>>;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ProblemFile {
+    title: String,
+    scene: Spanned<String>,
+    #[serde(default)]
+    description: String,
+    #[serde(default)]
+    params: RawParams,
+    #[serde(default)]
+    presets: BTreeMap<String, Spanned<RawParams>>,
+    #[serde(default)]
+    cases: Vec<Spanned<GroupFile>>,
+    #[serde(default)]
+    figures: Vec<Spanned<FigureFile>>,
+    #[serde(default)]
+    tables: Vec<Spanned<TableFile>>,
+    #[serde(default)]
+    bounds: Vec<Spanned<BoundFile>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GroupFile {
+    #[serde(default)]
+    name: Option<String>,
+    #[serde(default)]
+    params: RawParams,
+    #[serde(default)]
+    grid: RawParams,
+}
+
+/// The parts of a figure, table or bound that pick cases.
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SelectFile {
+    #[serde(default)]
+    cases: Vec<String>,
+    #[serde(default, rename = "where")]
+    where_: RawParams,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FigureFile {
+    id: String,
+    kind: String,
+    title: String,
+    #[serde(default)]
+    caption: String,
+    #[serde(default)]
+    paper: String,
+    #[serde(default)]
+    cases: Vec<String>,
+    #[serde(default, rename = "where")]
+    where_: RawParams,
+    #[serde(default)]
+    y: Option<String>,
+    #[serde(default)]
+    exact: Option<String>,
+    #[serde(default)]
+    y_label: Option<String>,
+    #[serde(default)]
+    log_y: bool,
+    #[serde(default)]
+    metric: Option<String>,
+    #[serde(default)]
+    label: Vec<String>,
+    #[serde(default)]
+    x: Option<String>,
+    #[serde(default)]
+    field: Option<String>,
+    #[serde(default)]
+    max: Option<f64>,
+    #[serde(default)]
+    converges: bool,
+    #[serde(default)]
+    lower: Option<SelectFile>,
+    #[serde(default)]
+    higher: Option<SelectFile>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TableFile {
+    id: String,
+    title: String,
+    #[serde(default)]
+    caption: String,
+    #[serde(default)]
+    cases: Vec<String>,
+    #[serde(default, rename = "where")]
+    where_: RawParams,
+    #[serde(default)]
+    columns: Vec<String>,
+    metrics: Vec<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BoundFile {
+    metric: String,
+    #[serde(default)]
+    cases: Vec<String>,
+    #[serde(default, rename = "where")]
+    where_: RawParams,
+    #[serde(default)]
+    max: Option<f64>,
+    #[serde(default)]
+    min: Option<f64>,
+    #[serde(default)]
+    presets: Option<Vec<String>>,
+}
+
+/// One simulation: a scene with every parameter resolved.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Name, unique within its problem (letters, digits, `.`, `_`, `-`).
+    pub name: String,
+    /// Scene name.
+    pub scene: String,
+    /// Every declared parameter, defaults filled in.
+    pub params: Params,
+}
+
+/// Which cases a figure, table or bound is about: names (globs) and parameter values; a
+/// case is selected when it matches one of the globs (or there are none) and every value.
+#[derive(Clone, Debug, Default)]
+pub struct Select {
+    /// Globs over case names (empty: every case).
+    pub cases: Vec<String>,
+    /// Parameter values the case must have.
+    pub where_: BTreeMap<String, Value>,
+}
+
+impl Select {
+    /// Whether `case` is selected.
+    pub fn matches(&self, case: &Case) -> bool {
+        let by_name = self.cases.is_empty()
+            || self
+                .cases
+                .iter()
+                .any(|g| glob_matches(g, &case.name).unwrap_or(false));
+        by_name
+            && self
+                .where_
+                .iter()
+                .all(|(k, v)| case.params.0.get(k).is_some_and(|c| values_equal(c, v)))
+    }
+
+    /// The selected cases, in problem order.
+    pub fn pick<'a>(&self, cases: &'a [Case]) -> Vec<&'a Case> {
+        cases.iter().filter(|c| self.matches(c)).collect()
+    }
+}
+
+/// Whether `name` matches the glob `pattern`.
+pub fn glob_matches(pattern: &str, name: &str) -> Result<bool, String> {
+    globset::Glob::new(pattern)
+        .map(|g| g.compile_matcher().is_match(name))
+        .map_err(|e| format!("bad glob `{pattern}`: {e}"))
+}
+
+fn values_equal(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Float(x), Value::Int(i)) | (Value::Int(i), Value::Float(x)) => *x == *i as f64,
+        _ => a == b,
+    }
+}
+
+/// What a figure draws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FigureKind {
+    /// A `timeseries.csv` column against `t`, one curve per case, with an optional exact
+    /// curve (dashed) from the first case.
+    Timeseries {
+        /// Column drawn.
+        y: String,
+        /// Column holding the exact solution.
+        exact: Option<String>,
+    },
+    /// The particles of one case's last snapshot, coloured by a point array.
+    Particles {
+        /// Point array (e.g. `pressure`).
+        field: String,
+    },
+    /// Error against cost (wall time and particle-steps) with the Pareto front, and the
+    /// same as a table with the observed orders of convergence along `x`.
+    Trade {
+        /// The resolution parameter (e.g. `nx`); h is taken as `1 / x`.
+        x: String,
+    },
+    /// Outcome map (stable / inaccurate / diverged) of the curve groups against parameter
+    /// `x`, and the same as a table.
+    Stability {
+        /// Swept parameter.
+        x: String,
+        /// Above this value of the metric a case that completed is inaccurate.
+        max: f64,
+    },
+}
+
+/// A figure a problem regenerates.
+#[derive(Clone, Debug)]
+pub struct Figure {
+    /// File stem, named after the paper (e.g. `fig06a_tg_decay_sun_re100`).
+    pub id: String,
+    /// What it draws.
+    pub kind: FigureKind,
+    /// Title.
+    pub title: String,
+    /// Caption in the manuscript.
+    pub caption: String,
+    /// What the paper shows, for the manuscript's comparison line.
+    pub paper: String,
+    /// Cases drawn.
+    pub select: Select,
+    /// Y-axis label (with units).
+    pub y_label: Option<String>,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The summary metric reported in the manuscript (and drawn by trade and stability).
+    pub metric: Option<String>,
+    /// Parameters naming each curve (or each row of a stability map).
+    pub label: Vec<String>,
+    /// The paper's claim: the metric decreases as the last `label` parameter grows.
+    pub converges: bool,
+    /// The paper's claim: the `lower` cases have a smaller metric than the `higher` ones.
+    pub lower_than: Option<(Select, Select)>,
+}
+
+/// A table of summary values.
+#[derive(Clone, Debug)]
+pub struct Table {
+    /// File stem.
+    pub id: String,
+    /// Title.
+    pub title: String,
+    /// Caption.
+    pub caption: String,
+    /// Rows.
+    pub select: Select,
+    /// Parameter columns.
+    pub columns: Vec<String>,
+    /// Metric columns.
+    pub metrics: Vec<String>,
+}
+
+/// A bound `check` enforces.
+#[derive(Clone, Debug)]
+pub struct Bound {
+    /// Metric.
+    pub metric: String,
+    /// Cases it applies to.
+    pub select: Select,
+    /// Largest accepted value.
+    pub max: Option<f64>,
+    /// Smallest accepted value.
+    pub min: Option<f64>,
+    /// Presets it applies to (bounds are measured on one).
+    pub presets: Vec<String>,
+    /// Line in the problem file.
+    pub line: usize,
+}
+
+/// A problem: one paper benchmark, with its cases expanded for one preset.
+#[derive(Clone)]
+pub struct Problem {
+    /// File stem, used as the output folder name.
+    pub name: String,
+    /// Problem file.
+    pub path: PathBuf,
+    /// Title.
+    pub title: String,
+    /// Description (Markdown), for the manuscript.
+    pub description: String,
+    /// Scene.
+    pub scene: &'static SceneEntry,
+    /// Preset the cases were expanded for.
+    pub preset: String,
+    /// Cases of this preset.
+    pub cases: Vec<Case>,
+    /// Figures.
+    pub figures: Vec<Figure>,
+    /// Tables.
+    pub tables: Vec<Table>,
+    /// Bounds that apply to this preset.
+    pub bounds: Vec<Bound>,
+}
+
+impl std::fmt::Debug for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Problem")
+            .field("name", &self.name)
+            .field("scene", &self.scene.name)
+            .field("preset", &self.preset)
+            .field("cases", &self.cases)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Where an error is: file and line.
+struct Loc<'a> {
+    path: &'a Path,
+    src: &'a str,
+}
+
+impl Loc<'_> {
+    fn line(&self, offset: usize) -> usize {
+        self.src[..offset.min(self.src.len())].matches('\n').count() + 1
+    }
+    fn err(&self, span: std::ops::Range<usize>, key: &str, msg: impl std::fmt::Display) -> String {
+        format!(
+            "{}:{}: `{key}`: {msg}",
+            self.path.display(),
+            self.line(span.start)
+        )
+    }
+}
+
+/// Loads and validates every `*.toml` in `dir`, sorted by name, expanded for `preset`.
+/// Problems without that preset are an error naming them.
+pub fn load_dir(dir: &Path, preset: &str) -> Result<Vec<Problem>, String> {
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| format!("{}: cannot read the problems folder: {e}", dir.display()))?;
+    let mut paths: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    if paths.is_empty() {
+        return Err(format!("{}: no problem files (*.toml)", dir.display()));
+    }
+    let mut errors = Vec::new();
+    let mut problems = Vec::new();
+    for p in &paths {
+        match load(p, preset) {
+            Ok(pr) => problems.push(pr),
+            Err(e) => errors.push(e),
+        }
+    }
+    if errors.is_empty() {
+        Ok(problems)
+    } else {
+        Err(errors.join("\n"))
+    }
+}
+
+/// Loads, validates and expands one problem file for `preset`. Every preset of the file is
+/// expanded and checked, so an error in `paper` is found while running `quick`.
+pub fn load(path: &Path, preset: &str) -> Result<Problem, String> {
+    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    parse(path, &src, preset)
+}
+
+/// [`load`] from a string (`path` names it in errors).
+pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
+    let loc = Loc { path, src };
+    let file: ProblemFile = toml::from_str(src).map_err(|e| {
+        let line = e.span().map(|s| loc.line(s.start)).unwrap_or(1);
+        format!(
+            "{}:{line}: {}",
+            path.display(),
+            e.message().trim_end().replace('\n', " ")
+        )
+    })?;
+    let scene =
+        scenes::find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    if !valid_name(&name) {
+        return Err(format!(
+            "{}: the file name must use letters, digits, `.`, `_` and `-` only",
+            path.display()
+        ));
+    }
+    let specs = (scene.params)();
+    if !file.presets.contains_key(DEFAULT_PRESET) {
+        return Err(format!(
+            "{}: no [presets.{DEFAULT_PRESET}] (the default preset)",
+            path.display()
+        ));
+    }
+    if file.cases.is_empty() {
+        return Err(format!(
+            "{}: no [[cases]]: a problem needs at least one",
+            path.display()
+        ));
+    }
+    // Preset variables: every preset defines the same names.
+    let first_vars: Vec<&String> = file
+        .presets
+        .values()
+        .next()
+        .unwrap()
+        .get_ref()
+        .keys()
+        .collect();
+    for (pname, vars) in &file.presets {
+        let names: Vec<&String> = vars.get_ref().keys().collect();
+        if names != first_vars {
+            return Err(loc.err(
+                vars.span(),
+                &format!("presets.{pname}"),
+                format!(
+                    "every preset must define the same variables (found {:?}, expected {:?})",
+                    names, first_vars
+                ),
+            ));
+        }
+    }
+    let mut out = None;
+    for (pname, vars) in &file.presets {
+        let p = expand(&loc, &file, scene, &specs, &name, pname, vars.get_ref())?;
+        if pname == preset {
+            out = Some(p);
+        }
+    }
+    out.ok_or_else(|| {
+        let known: Vec<_> = file.presets.keys().cloned().collect();
+        format!(
+            "{}: no preset `{preset}`; this problem has: {}",
+            path.display(),
+            known.join(", ")
+        )
+    })
+}
+
+fn valid_name(s: &str) -> bool {
+    !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'))
+}
+
+/// A value as written, after substituting preset variables: one value or a list.
+enum Raw {
+    One(Value),
+    List(Vec<Value>),
+}
+
+fn to_value(v: &toml::Value) -> Result<Value, String> {
+    Ok(match v {
+        toml::Value::Boolean(b) => Value::Bool(*b),
+        toml::Value::Integer(i) => Value::Int(*i),
+        toml::Value::Float(x) => Value::Float(*x),
+        toml::Value::String(s) => Value::Str(s.clone()),
+        other => {
+            return Err(format!(
+                "expected a number, a boolean or a name, found {other}"
+            ))
+        }
+    })
+}
+
+fn resolve_raw(
+    loc: &Loc,
+    key: &str,
+    v: &Spanned<toml::Value>,
+    vars: &RawParams,
+    preset: &str,
+) -> Result<Raw, String> {
+    let err = |m: String| loc.err(v.span(), key, m);
+    let mut val = v.get_ref();
+    if let toml::Value::String(s) = val {
+        if let Some(var) = s.strip_prefix('$') {
+            val = vars.get(var).map(|x| x.get_ref()).ok_or_else(|| {
+                err(format!(
+                    "preset `{preset}` does not define the variable `{var}`"
+                ))
+            })?;
+        }
+    }
+    match val {
+        toml::Value::Array(a) => a
+            .iter()
+            .map(to_value)
+            .collect::<Result<Vec<_>, _>>()
+            .map(Raw::List)
+            .map_err(err),
+        other => to_value(other).map(Raw::One).map_err(err),
+    }
+}
+
+fn check_param(
+    loc: &Loc,
+    span: std::ops::Range<usize>,
+    scene: &SceneEntry,
+    specs: &[Spec],
+    key: &str,
+    v: &Value,
+) -> Result<Value, String> {
+    let spec = specs.iter().find(|s| s.name == key).ok_or_else(|| {
+        let known: Vec<_> = specs.iter().map(|s| s.name).collect();
+        loc.err(
+            span.clone(),
+            key,
+            format!(
+                "scene `{}` has no parameter `{key}`; known parameters: {}",
+                scene.name,
+                known.join(", ")
+            ),
+        )
+    })?;
+    spec.check(scene.name, v).map_err(|e| loc.err(span, key, e))
+}
+
+/// Checks a `where` table: known parameters, values of the right type.
+fn select(
+    loc: &Loc,
+    scene: &SceneEntry,
+    specs: &[Spec],
+    cases: &[String],
+    where_: &RawParams,
+    vars: &RawParams,
+    preset: &str,
+) -> Result<Select, String> {
+    let mut w = BTreeMap::new();
+    for (k, v) in where_ {
+        match resolve_raw(loc, k, v, vars, preset)? {
+            Raw::One(x) => {
+                w.insert(k.clone(), check_param(loc, v.span(), scene, specs, k, &x)?);
+            }
+            Raw::List(_) => return Err(loc.err(v.span(), k, "a `where` value must be one value")),
+        }
+    }
+    for g in cases {
+        globset::Glob::new(g)
+            .map_err(|e| format!("{}: bad glob `{g}`: {e}", loc.path.display()))?;
+    }
+    Ok(Select {
+        cases: cases.to_vec(),
+        where_: w,
+    })
+}
+
+/// Checks that a selection matches at least one case.
+fn nonempty(
+    loc: &Loc,
+    span: std::ops::Range<usize>,
+    what: &str,
+    s: &Select,
+    cases: &[Case],
+    preset: &str,
+) -> Result<(), String> {
+    if s.pick(cases).is_empty() {
+        let desc = format!(
+            "{}{}",
+            if s.cases.is_empty() {
+                String::new()
+            } else {
+                format!("cases {:?} ", s.cases)
+            },
+            if s.where_.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "where {}",
+                    s.where_
+                        .iter()
+                        .map(|(k, v)| format!("{k} = {v}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            }
+        );
+        for g in &s.cases {
+            if !cases
+                .iter()
+                .any(|c| glob_matches(g, &c.name).unwrap_or(false))
+            {
+                return Err(loc.err(
+                    span,
+                    what,
+                    format!("no case named `{g}` in preset `{preset}`"),
+                ));
+            }
+        }
+        return Err(loc.err(
+            span,
+            what,
+            format!("{desc} selects no case in preset `{preset}`"),
+        ));
+    }
+    Ok(())
+}
+
+fn check_metric(
+    loc: &Loc,
+    span: std::ops::Range<usize>,
+    what: &str,
+    scene: &SceneEntry,
+    m: &str,
+) -> Result<(), String> {
+    if scene.metrics.contains(&m) {
+        Ok(())
+    } else {
+        Err(loc.err(
+            span,
+            what,
+            format!(
+                "scene `{}` has no metric `{m}`; its metrics: {}",
+                scene.name,
+                scene.metrics.join(", ")
+            ),
+        ))
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn expand(
+    loc: &Loc,
+    file: &ProblemFile,
+    scene: &'static SceneEntry,
+    specs: &[Spec],
+    name: &str,
+    preset: &str,
+    vars: &RawParams,
+) -> Result<Problem, String> {
+    // Problem-wide parameters over the defaults.
+    let mut base = Params::defaults(specs);
+    for (k, v) in &file.params {
+        match resolve_raw(loc, k, v, vars, preset)? {
+            Raw::One(x) => {
+                let x = check_param(loc, v.span(), scene, specs, k, &x)?;
+                base.0.insert(k.clone(), x);
+            }
+            Raw::List(_) => {
+                return Err(loc.err(v.span(), k, "a list is a grid: put it under [cases.grid]"))
+            }
+        }
+    }
+    let mut cases: Vec<Case> = Vec::new();
+    let mut case_lines: BTreeMap<String, usize> = BTreeMap::new();
+    for g in &file.cases {
+        let gspan = g.span();
+        let g = g.get_ref();
+        let mut fixed = base.clone();
+        let mut set_keys: Vec<(String, Vec<Value>)> = Vec::new();
+        for (k, v) in &g.params {
+            match resolve_raw(loc, k, v, vars, preset)? {
+                Raw::One(x) => {
+                    let x = check_param(loc, v.span(), scene, specs, k, &x)?;
+                    fixed.0.insert(k.clone(), x.clone());
+                    set_keys.push((k.clone(), vec![x]));
+                }
+                Raw::List(_) => {
+                    return Err(loc.err(v.span(), k, "a list belongs under [cases.grid]"))
+                }
+            }
+        }
+        for (k, v) in &g.grid {
+            let vals = match resolve_raw(loc, k, v, vars, preset)? {
+                Raw::One(x) => vec![x],
+                Raw::List(l) => l,
+            };
+            if vals.is_empty() {
+                return Err(loc.err(v.span(), k, "an empty list makes no case"));
+            }
+            let vals = vals
+                .iter()
+                .map(|x| check_param(loc, v.span(), scene, specs, k, x))
+                .collect::<Result<Vec<_>, _>>()?;
+            set_keys.retain(|(s, _)| s != k);
+            set_keys.push((k.clone(), vals));
+        }
+        // Product of the grid (like automan's mdict/dprod).
+        let mut combos: Vec<Params> = vec![fixed];
+        for (k, vals) in &set_keys {
+            combos = combos
+                .into_iter()
+                .flat_map(|p| {
+                    vals.iter().map(move |v| {
+                        let mut q = p.clone();
+                        q.0.insert(k.clone(), v.clone());
+                        q
+                    })
+                })
+                .collect();
+        }
+        for p in combos {
+            let cname = case_name(g.name.as_deref(), &set_keys, &p)
+                .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
+            if !valid_name(&cname) {
+                return Err(loc.err(
+                    gspan.clone(),
+                    "cases.name",
+                    format!("case name `{cname}` may use letters, digits, `.`, `_` and `-` only"),
+                ));
+            }
+            if let Some(other) = cases.iter().find(|c| c.name == cname) {
+                if other.params == p {
+                    continue;
+                }
+                return Err(loc.err(
+                    gspan.clone(),
+                    "cases.name",
+                    format!(
+                        "two cases are named `{cname}` (the first on line {}) with different parameters",
+                        case_lines[&cname]
+                    ),
+                ));
+            }
+            if cases.iter().any(|c| c.params == p) {
+                continue; // the same simulation under another name: run it once
+            }
+            case_lines.insert(cname.clone(), loc.line(gspan.start));
+            cases.push(Case {
+                name: cname,
+                scene: scene.name.to_string(),
+                params: p,
+            });
+        }
+    }
+
+    let sel = |cases_: &[String], w: &RawParams| select(loc, scene, specs, cases_, w, vars, preset);
+    let mut figures = Vec::new();
+    let mut ids: BTreeMap<String, usize> = BTreeMap::new();
+    for f in &file.figures {
+        let span = f.span();
+        let f = f.get_ref();
+        let key = format!("figures.{}", f.id);
+        if !valid_name(&f.id) {
+            return Err(loc.err(
+                span,
+                &key,
+                "an id may use letters, digits, `.`, `_` and `-` only",
+            ));
+        }
+        if let Some(l) = ids.insert(f.id.clone(), loc.line(span.start)) {
+            return Err(loc.err(
+                span,
+                &key,
+                format!("a figure or table on line {l} has the same id"),
+            ));
+        }
+        let select = sel(&f.cases, &f.where_)?;
+        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
+        for l in &f.label {
+            if !specs.iter().any(|s| s.name == l) {
+                return Err(loc.err(span, &key, format!("`label` names no parameter `{l}`")));
+            }
+        }
+        if let Some(m) = &f.metric {
+            check_metric(loc, span.clone(), &key, scene, m)?;
+        }
+        let need = |what: &str, v: &Option<String>| {
+            v.clone().ok_or_else(|| {
+                loc.err(
+                    span.clone(),
+                    &key,
+                    format!("kind `{}` needs `{what}`", f.kind),
+                )
+            })
+        };
+        let kind = match f.kind.as_str() {
+            "timeseries" => FigureKind::Timeseries {
+                y: need("y", &f.y)?,
+                exact: f.exact.clone(),
+            },
+            "particles" => FigureKind::Particles {
+                field: need("field", &f.field)?,
+            },
+            "trade" => {
+                need("metric", &f.metric)?;
+                let x = need("x", &f.x)?;
+                if !specs.iter().any(|s| s.name == x) {
+                    return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
+                }
+                FigureKind::Trade { x }
+            }
+            "stability" => {
+                need("metric", &f.metric)?;
+                let x = need("x", &f.x)?;
+                if !specs.iter().any(|s| s.name == x) {
+                    return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
+                }
+                FigureKind::Stability {
+                    x,
+                    max: f.max.ok_or_else(|| {
+                        loc.err(span.clone(), &key, "kind `stability` needs `max`")
+                    })?,
+                }
+            }
+            other => {
+                return Err(loc.err(
+                    span,
+                    &key,
+                    format!(
+                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability"
+                    ),
+                ))
+            }
+        };
+        if (f.converges || f.lower.is_some()) && f.metric.is_none() {
+            return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
+        }
+        if f.converges && f.label.is_empty() {
+            return Err(loc.err(
+                span,
+                &key,
+                "`converges` needs `label` (the resolution last)",
+            ));
+        }
+        let lower_than = match (&f.lower, &f.higher) {
+            (Some(a), Some(b)) => {
+                let a = sel(&a.cases, &a.where_)?;
+                let b = sel(&b.cases, &b.where_)?;
+                nonempty(
+                    loc,
+                    span.clone(),
+                    &format!("{key}.lower"),
+                    &a,
+                    &cases,
+                    preset,
+                )?;
+                nonempty(
+                    loc,
+                    span.clone(),
+                    &format!("{key}.higher"),
+                    &b,
+                    &cases,
+                    preset,
+                )?;
+                Some((a, b))
+            }
+            (None, None) => None,
+            _ => return Err(loc.err(span, &key, "`lower` and `higher` go together")),
+        };
+        figures.push(Figure {
+            id: f.id.clone(),
+            kind,
+            title: f.title.clone(),
+            caption: f.caption.clone(),
+            paper: f.paper.clone(),
+            select,
+            y_label: f.y_label.clone(),
+            log_y: f.log_y,
+            metric: f.metric.clone(),
+            label: f.label.clone(),
+            converges: f.converges,
+            lower_than,
+        });
+    }
+    let mut tables = Vec::new();
+    for t in &file.tables {
+        let span = t.span();
+        let t = t.get_ref();
+        let key = format!("tables.{}", t.id);
+        if let Some(l) = ids.insert(t.id.clone(), loc.line(span.start)) {
+            return Err(loc.err(
+                span,
+                &key,
+                format!("a figure or table on line {l} has the same id"),
+            ));
+        }
+        let select = sel(&t.cases, &t.where_)?;
+        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
+        for m in &t.metrics {
+            check_metric(loc, span.clone(), &key, scene, m)?;
+        }
+        for c in &t.columns {
+            if !specs.iter().any(|s| s.name == c) {
+                return Err(loc.err(span, &key, format!("`columns` names no parameter `{c}`")));
+            }
+        }
+        tables.push(Table {
+            id: t.id.clone(),
+            title: t.title.clone(),
+            caption: t.caption.clone(),
+            select,
+            columns: t.columns.clone(),
+            metrics: t.metrics.clone(),
+        });
+    }
+    let mut bounds = Vec::new();
+    for b in &file.bounds {
+        let span = b.span();
+        let b = b.get_ref();
+        let key = format!("bounds.{}", b.metric);
+        check_metric(loc, span.clone(), "bounds.metric", scene, &b.metric)?;
+        if b.max.is_none() && b.min.is_none() {
+            return Err(loc.err(span, &key, "a bound needs `max` or `min`"));
+        }
+        let presets = b
+            .presets
+            .clone()
+            .unwrap_or_else(|| vec![DEFAULT_PRESET.to_string()]);
+        for p in &presets {
+            if !file.presets.contains_key(p) {
+                return Err(loc.err(span, &key, format!("no preset `{p}`")));
+            }
+        }
+        if !presets.iter().any(|p| p == preset) {
+            continue;
+        }
+        let select = sel(&b.cases, &b.where_)?;
+        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
+        bounds.push(Bound {
+            metric: b.metric.clone(),
+            select,
+            max: b.max,
+            min: b.min,
+            presets,
+            line: loc.line(span.start),
+        });
+    }
+    Ok(Problem {
+        name: name.to_string(),
+        path: loc.path.to_path_buf(),
+        title: file.title.clone(),
+        description: file.description.clone(),
+        scene,
+        preset: preset.to_string(),
+        cases,
+        figures,
+        tables,
+        bounds,
+    })
+}
+
+/// A case name: the group's template with `{key}` replaced by the parameter's value, or,
+/// without a template, `key-value` for every key the group sets, joined by `_`.
+fn case_name(
+    template: Option<&str>,
+    set_keys: &[(String, Vec<Value>)],
+    p: &Params,
+) -> Result<String, String> {
+    let show = |v: &Value| match v {
+        Value::Float(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{}", *x as i64),
+        v => v.to_string(),
+    };
+    match template {
+        Some(t) => {
+            let mut out = String::new();
+            let mut rest = t;
+            while let Some(i) = rest.find('{') {
+                out.push_str(&rest[..i]);
+                let j = rest[i..]
+                    .find('}')
+                    .ok_or_else(|| format!("unclosed `{{` in name template `{t}`"))?;
+                let key = &rest[i + 1..i + j];
+                let v =
+                    p.0.get(key)
+                        .ok_or_else(|| format!("name template `{t}` names no parameter `{key}`"))?;
+                out.push_str(&show(v));
+                rest = &rest[i + j + 1..];
+            }
+            out.push_str(rest);
+            Ok(out)
+        }
+        None => Ok(set_keys
+            .iter()
+            .map(|(k, _)| format!("{k}-{}", show(&p.0[k])))
+            .collect::<Vec<_>>()
+            .join("_")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+title = "t"
+scene = "taylor_green"
+[params]
+tf = "$tf"
+[presets.quick]
+tf = 0.05
+nx = [12, 16]
+[presets.paper]
+tf = 2.0
+nx = [50, 100]
+[[cases]]
+name = "sun-nx{nx}"
+params = { pst = "sun" }
+grid = { nx = "$nx" }
+[[cases]]
+grid = { scheme = ["edac", "ctvf"], nx = 16 }
+[[figures]]
+id = "f1"
+kind = "timeseries"
+title = "x"
+y = "u_max"
+cases = ["sun-*"]
+metric = "l1_velocity_final"
+label = ["nx"]
+[[bounds]]
+metric = "l1_velocity_final"
+where = { nx = 16, pst = "sun", scheme = "ctvf" }
+max = 1.0
+"#;
+
+    fn p(src: &str) -> Result<Problem, String> {
+        parse(Path::new("x.toml"), src, "quick")
+    }
+
+    #[test]
+    fn expands_grids_and_merges_identical_cases() {
+        let pr = p(GOOD).unwrap();
+        let names: Vec<_> = pr.cases.iter().map(|c| c.name.as_str()).collect();
+        // sun-nx16 and the ctvf case of the second group are the same simulation.
+        assert_eq!(names, ["sun-nx12", "sun-nx16", "nx-16_scheme-edac"]);
+        assert_eq!(pr.cases[0].params.0["tf"], Value::Float(0.05));
+        assert_eq!(pr.bounds.len(), 1);
+        let paper = parse(Path::new("x.toml"), GOOD, "paper").unwrap();
+        assert_eq!(paper.cases[1].name, "sun-nx100");
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let e = p(&GOOD.replace("title = \"x\"", "title = \"x\"\ncolour = 3")).unwrap_err();
+        assert!(e.contains("x.toml:") && e.contains("colour"), "{e}");
+        let e = p(&GOOD.replace("pst = \"sun\"", "pst = \"warp\"")).unwrap_err();
+        assert!(e.starts_with("x.toml:14:") && e.contains("pst"), "{e}");
+        let e = p(&GOOD.replace("pst = \"sun\" }", "pst = \"sun\", frob = 1 }")).unwrap_err();
+        assert!(e.contains("frob") && e.contains(":14:"), "{e}");
+        let e = p(&GOOD.replace("nx = 16 }", "nx = 1.5 }")).unwrap_err();
+        assert!(e.contains("nx") && e.contains("integer"), "{e}");
+        let e = p(&GOOD.replace("\"sun-*\"", "\"nope\"")).unwrap_err();
+        assert!(e.contains("nope") && e.contains("x.toml:1"), "{e}");
+        let e = p(&GOOD.replace(
+            "metric = \"l1_velocity_final\"\nlabel",
+            "metric = \"l2\"\nlabel",
+        ))
+        .unwrap_err();
+        assert!(e.contains("l2"), "{e}");
+        let e = p(&GOOD.replace("taylor_green", "nope")).unwrap_err();
+        assert!(e.contains("x.toml:3:") && e.contains("nope"), "{e}");
+        let dup = GOOD.replace(
+            "[[figures]]",
+            "[[cases]]\nname = \"sun-nx12\"\nparams = { re = 5 }\n[[figures]]",
+        );
+        let e = p(&dup).unwrap_err();
+        assert!(e.contains("sun-nx12") && e.contains("two cases"), "{e}");
+    }
+}

@@ -1,0 +1,364 @@
+//! The task runner: decides which cases must run (missing, failed, stale or forced), runs
+//! them as subprocesses of this binary (`sphrepro simulate ... --out DIR`, as automan's
+//! `CommandTask`) in a job pool that splits the cores between concurrent cases and their
+//! rayon threads, shows one progress bar per running case plus an overall one, keeps one
+//! log per case, and collects failures instead of stopping at the first.
+
+use super::cache::{Entry, State};
+use super::lock::{Lock, Try};
+use super::registry::Problem;
+use crate::scenes::harness::INTERRUPTED;
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::collections::VecDeque;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// How to run.
+#[derive(Clone, Debug, Default)]
+pub struct Options {
+    /// Concurrent cases (default: from the core count).
+    pub jobs: Option<usize>,
+    /// Re-run done cases too.
+    pub force: bool,
+    /// Only cases whose name matches this glob.
+    pub matching: Option<String>,
+    /// Print the plan, run nothing.
+    pub dry_run: bool,
+    /// Checkpoint interval passed to `simulate` (seconds), when it supports it.
+    pub checkpoint_every: Option<f64>,
+}
+
+/// A case to run and why.
+#[derive(Clone, Debug)]
+pub struct Task {
+    /// Problem name.
+    pub problem: String,
+    /// The case and its folder.
+    pub entry: Entry,
+    /// Why it runs.
+    pub reason: String,
+}
+
+/// What a run did.
+#[derive(Debug, Default)]
+pub struct Report {
+    /// Cases simulated to a result (completed or diverged).
+    pub ran: Vec<String>,
+    /// Cases skipped because they were done.
+    pub skipped: usize,
+    /// Cases that did not produce a result: (case, log file, reason).
+    pub failures: Vec<(String, PathBuf, String)>,
+    /// Whether Ctrl-C stopped the run.
+    pub interrupted: bool,
+}
+
+/// The cases of `problems` that must run, with the reason, and how many are done.
+pub fn plan(
+    output: &Path,
+    problems: &[Problem],
+    opts: &Options,
+) -> Result<(Vec<Task>, usize), String> {
+    let matcher = match &opts.matching {
+        Some(g) => Some(
+            globset::Glob::new(g)
+                .map_err(|e| format!("--match `{g}`: {e}"))?
+                .compile_matcher(),
+        ),
+        None => None,
+    };
+    let mut tasks = Vec::new();
+    let mut done = 0;
+    for p in problems {
+        for e in super::cache::entries(output, p) {
+            if let Some(m) = &matcher {
+                if !m.is_match(&e.case.name) && !m.is_match(format!("{}/{}", p.name, e.case.name)) {
+                    continue;
+                }
+            }
+            let reason = match e.state() {
+                State::Done(_) if opts.force => "forced".to_string(),
+                State::Done(_) => {
+                    done += 1;
+                    continue;
+                }
+                State::Failed(r) => format!("failed before ({r}): re-run, resuming if it can"),
+                State::Missing(Some(change)) => format!("stale: {change}"),
+                State::Missing(None) => "missing".to_string(),
+            };
+            tasks.push(Task {
+                problem: p.name.clone(),
+                entry: e,
+                reason,
+            });
+        }
+    }
+    Ok((tasks, done))
+}
+
+/// Cores available to this process.
+pub fn cores() -> usize {
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
+}
+
+/// Concurrent cases and rayon threads per case for `tasks` cases: jobs x threads <= cores.
+pub fn split_cores(jobs: Option<usize>, tasks: usize) -> (usize, usize) {
+    let cores = cores();
+    let jobs = jobs.unwrap_or_else(|| cores.min(tasks)).max(1);
+    (jobs, (cores / jobs).max(1))
+}
+
+/// Whether this binary's `simulate` takes `--checkpoint-every`.
+fn simulate_checkpoints(exe: &Path) -> bool {
+    Command::new(exe)
+        .args(["simulate", "--help"])
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).contains("--checkpoint-every"))
+        .unwrap_or(false)
+}
+
+/// Prints a line above the progress bars.
+fn say(mp: &MultiProgress, line: String) {
+    mp.suspend(|| println!("{line}"));
+}
+
+/// Runs `tasks` in a job pool. Failures are collected, not fatal; Ctrl-C stops starting
+/// new cases and lets the running ones write their `failed` summary.
+pub fn execute(tasks: Vec<Task>, opts: &Options) -> Result<Report, String> {
+    let exe = std::env::current_exe().map_err(|e| format!("cannot find own executable: {e}"))?;
+    let (jobs, threads) = split_cores(opts.jobs, tasks.len());
+    let checkpoint = opts
+        .checkpoint_every
+        .filter(|_| !tasks.is_empty() && simulate_checkpoints(&exe));
+    let mp = MultiProgress::with_draw_target(if std::io::stderr().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    });
+    let total = mp.add(ProgressBar::new(tasks.len() as u64));
+    total.set_style(
+        ProgressStyle::with_template("{prefix:>12} [{elapsed_precise}] {bar:30} {pos}/{len} cases")
+            .expect("template"),
+    );
+    total.set_prefix("all");
+    if !tasks.is_empty() {
+        say(
+            &mp,
+            format!(
+                "running {} case(s): {jobs} at a time, {threads} thread(s) each",
+                tasks.len()
+            ),
+        );
+    }
+    let queue = Arc::new(Mutex::new(VecDeque::from(tasks)));
+    let report = Arc::new(Mutex::new(Report::default()));
+    std::thread::scope(|s| {
+        for _ in 0..jobs {
+            let (queue, report, mp, total, exe) = (&queue, &report, &mp, &total, &exe);
+            s.spawn(move || loop {
+                if INTERRUPTED.load(Ordering::SeqCst) {
+                    report.lock().unwrap().interrupted = true;
+                    break;
+                }
+                let Some(task) = queue.lock().unwrap().pop_front() else {
+                    break;
+                };
+                let name = format!("{}/{}", task.problem, task.entry.case.name);
+                let outcome = run_one(exe, &task, threads, checkpoint, opts.force, mp);
+                let mut r = report.lock().unwrap();
+                match outcome {
+                    Outcome::Done(secs, how) => {
+                        say(mp, format!("done    {name} ({how}, {secs:.1} s)"));
+                        r.ran.push(name);
+                    }
+                    Outcome::Skipped(why) => {
+                        say(mp, format!("skip    {name} ({why})"));
+                        r.skipped += 1;
+                    }
+                    Outcome::Failed(why) => {
+                        let log = task.entry.dir.join("run.log");
+                        say(
+                            mp,
+                            format!("FAILED  {name}: {why} (log: {})", log.display()),
+                        );
+                        r.failures.push((name, log, why));
+                    }
+                }
+                total.inc(1);
+            });
+        }
+    });
+    total.finish_and_clear();
+    let _ = mp.clear();
+    let mut r = std::mem::take(&mut *report.lock().unwrap());
+    r.interrupted |= INTERRUPTED.load(Ordering::SeqCst);
+    if r.interrupted {
+        for t in queue.lock().unwrap().iter() {
+            r.failures.push((
+                format!("{}/{}", t.problem, t.entry.case.name),
+                t.entry.dir.join("run.log"),
+                "not started: interrupted".into(),
+            ));
+        }
+    }
+    Ok(r)
+}
+
+enum Outcome {
+    Done(f64, String),
+    Skipped(String),
+    Failed(String),
+}
+
+fn run_one(
+    exe: &Path,
+    task: &Task,
+    threads: usize,
+    checkpoint: Option<f64>,
+    force: bool,
+    mp: &MultiProgress,
+) -> Outcome {
+    let e = &task.entry;
+    let name = format!("{}/{}", task.problem, e.case.name);
+    // One runner per case: wait while another holds it.
+    let mut waited = false;
+    let _lock = loop {
+        match Lock::try_take(&e.dir) {
+            Ok(Try::Taken(l)) => break l,
+            Ok(Try::Held(pid)) => {
+                if !waited {
+                    say(
+                        mp,
+                        format!("wait    {name} (another runner, pid {pid}, holds it)"),
+                    );
+                    waited = true;
+                }
+                if INTERRUPTED.load(Ordering::SeqCst) {
+                    return Outcome::Failed("interrupted while waiting for its lock".into());
+                }
+                std::thread::sleep(Duration::from_millis(300));
+            }
+            Err(err) => return Outcome::Failed(err),
+        }
+    };
+    // Another runner may have finished it while we waited.
+    if (waited || !force) && e.is_done() {
+        return Outcome::Skipped("done by another runner".into());
+    }
+    if let Err(err) = e.write_record() {
+        return Outcome::Failed(err);
+    }
+    say(mp, format!("run     {name} ({})", task.reason));
+    let log_path = e.dir.join("run.log");
+    let log = match std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(&log_path)
+    {
+        Ok(f) => f,
+        Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
+    };
+    let progress = e.dir.join("progress");
+    let _ = std::fs::remove_file(&progress);
+    let mut cmd = Command::new(exe);
+    cmd.arg("--threads")
+        .arg(threads.to_string())
+        .arg("simulate")
+        .arg(&e.case.scene)
+        .arg("--out")
+        .arg(&e.dir)
+        .arg("--quiet")
+        .arg("--progress-file")
+        .arg(&progress);
+    for (k, v) in &e.case.params.0 {
+        cmd.arg("--set").arg(format!("{k}={v}"));
+    }
+    if force {
+        cmd.arg("--force");
+    }
+    if let Some(c) = checkpoint {
+        cmd.arg("--checkpoint-every").arg(c.to_string());
+    }
+    let log2 = match log.try_clone() {
+        Ok(l) => l,
+        Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
+    };
+    cmd.stdout(Stdio::from(log)).stderr(Stdio::from(log2));
+    let t0 = Instant::now();
+    let mut child = match cmd.spawn() {
+        Ok(c) => c,
+        Err(err) => return Outcome::Failed(format!("cannot start {}: {err}", exe.display())),
+    };
+    let bar = mp.add(ProgressBar::new(1000));
+    bar.set_style(
+        ProgressStyle::with_template("{prefix:>12} [{elapsed_precise}] {bar:30} {msg}")
+            .expect("template"),
+    );
+    bar.set_prefix(short(&e.case.name, 12));
+    let mut signalled = false;
+    let status = loop {
+        match child.try_wait() {
+            Ok(Some(s)) => break Ok(s),
+            Ok(None) => {}
+            Err(err) => break Err(err),
+        }
+        if INTERRUPTED.load(Ordering::SeqCst) && !signalled {
+            // The terminal sends SIGINT to the child too; make sure it gets one.
+            let _ = Command::new("kill")
+                .args(["-INT", &child.id().to_string()])
+                .status();
+            signalled = true;
+        }
+        if let Ok(s) = std::fs::read_to_string(&progress) {
+            let v: Vec<f64> = s
+                .split_whitespace()
+                .filter_map(|x| x.parse().ok())
+                .collect();
+            if v.len() >= 2 && v[1] > 0.0 {
+                bar.set_position((v[0] / v[1] * 1000.0) as u64);
+                bar.set_message(format!("{}  t = {:.3}/{}", e.case.name, v[0], v[1]));
+            }
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    };
+    bar.finish_and_clear();
+    mp.remove(&bar);
+    let _ = std::fs::remove_file(&progress);
+    let secs = t0.elapsed().as_secs_f64();
+    let code = match status {
+        Ok(s) => s,
+        Err(err) => return Outcome::Failed(format!("waiting for the case: {err}")),
+    };
+    match e.state() {
+        State::Done(s) => Outcome::Done(
+            secs,
+            serde_json::to_value(s)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default(),
+        ),
+        State::Failed(r) => Outcome::Failed(format!("{r} (exit status {code})")),
+        State::Missing(_) => Outcome::Failed(format!("no result (exit status {code})")),
+    }
+}
+
+fn short(s: &str, n: usize) -> String {
+    if s.chars().count() <= n {
+        s.to_string()
+    } else {
+        let tail: String = s
+            .chars()
+            .rev()
+            .take(n - 1)
+            .collect::<Vec<_>>()
+            .into_iter()
+            .rev()
+            .collect();
+        format!("…{tail}")
+    }
+}

@@ -1,0 +1,727 @@
+//! Post-processing: the figures and tables a problem declares, drawn from cached results
+//! (`summary.json`, `timeseries.csv`, the last `.vtu` snapshot), with the manuscript's
+//! comparison line per figure: what the paper shows, what we got (numbers from the
+//! summaries) and whether the paper's claim holds here. Also the two reusable studies:
+//! the speed-accuracy trade (error against wall time and particle-steps, Pareto front,
+//! observed orders of convergence) and stability maps (stable / inaccurate / diverged).
+
+use super::cache::Entry;
+use super::registry::{Case, Figure, FigureKind, Problem, Select, Table};
+use super::report::{self, Item, Outcome, Section, Series, SeriesStyle};
+use crate::solver::output::summary::{Status, Summary};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// A selected case with its cached summary, if done.
+struct Run<'a> {
+    case: &'a Case,
+    entry: Entry,
+    summary: Option<Summary>,
+}
+
+fn runs<'a>(output: &Path, p: &'a Problem, s: &Select) -> Vec<Run<'a>> {
+    s.pick(&p.cases)
+        .into_iter()
+        .map(|c| {
+            let entry = Entry::new(output, p, c);
+            let summary = entry
+                .summary()
+                .filter(|s| matches!(s.status, Status::Completed | Status::Diverged));
+            Run {
+                case: c,
+                entry,
+                summary,
+            }
+        })
+        .collect()
+}
+
+/// `key = value, ...` of the `keys` parameters of `case` (its name if none).
+fn label(case: &Case, keys: &[String]) -> String {
+    if keys.is_empty() {
+        return case.name.clone();
+    }
+    keys.iter()
+        .map(|k| {
+            format!(
+                "{k} = {}",
+                case.params
+                    .0
+                    .get(k)
+                    .map(|v| v.to_string())
+                    .unwrap_or_default()
+            )
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Values of the `keys` parameters joined by `/` (a curve group).
+fn group(case: &Case, keys: &[String]) -> String {
+    keys.iter()
+        .map(|k| {
+            case.params
+                .0
+                .get(k)
+                .map(|v| v.to_string())
+                .unwrap_or_default()
+        })
+        .collect::<Vec<_>>()
+        .join("/")
+}
+
+fn param_f64(case: &Case, key: &str) -> f64 {
+    match case.params.0.get(key) {
+        Some(crate::scenes::params::Value::Int(i)) => *i as f64,
+        Some(crate::scenes::params::Value::Float(x)) => *x,
+        _ => f64::NAN,
+    }
+}
+
+fn metric(r: &Run, m: &str) -> Option<f64> {
+    r.summary.as_ref().and_then(|s| s.metrics.get(m).copied())
+}
+
+fn fmt(x: f64) -> String {
+    format!("{x:.3e}")
+}
+
+/// Reads columns `t` and `y` of a case's `timeseries.csv`.
+fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
+    let path = dir.join("timeseries.csv");
+    let mut rd = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let headers = rd
+        .headers()
+        .map_err(|e| format!("{}: {e}", path.display()))?
+        .clone();
+    let col = |name: &str| {
+        headers.iter().position(|h| h == name).ok_or_else(|| {
+            format!(
+                "{}: no column `{name}`; columns: {}",
+                path.display(),
+                headers.iter().collect::<Vec<_>>().join(", ")
+            )
+        })
+    };
+    let (it, iy) = (col("t")?, col(y)?);
+    let (mut t, mut v) = (Vec::new(), Vec::new());
+    for rec in rd.records() {
+        let rec = rec.map_err(|e| format!("{}: {e}", path.display()))?;
+        let a: f64 = rec[it].trim().parse().unwrap_or(f64::NAN);
+        let b: f64 = rec[iy].trim().parse().unwrap_or(f64::NAN);
+        t.push(a);
+        v.push(b);
+    }
+    Ok((t, v))
+}
+
+/// The text of the first `<DataArray ...>` after `from` whose tag contains `tag_has`.
+fn data_array<'a>(xml: &'a str, from: usize, tag_has: &str) -> Option<&'a str> {
+    let mut at = from;
+    loop {
+        let i = at + xml[at..].find("<DataArray")?;
+        let close = i + xml[i..].find('>')?;
+        if xml[i..close].contains(tag_has) {
+            let end = close + xml[close..].find("</DataArray>")?;
+            return Some(&xml[close + 1..end]);
+        }
+        at = close;
+    }
+}
+
+/// Points (x, y) and one scalar point array of the last snapshot listed in `fluid.pvd`.
+fn last_snapshot(dir: &Path, field: &str) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, f64), String> {
+    let pvd = dir.join("fluid.pvd");
+    let s = std::fs::read_to_string(&pvd).map_err(|e| format!("{}: {e}", pvd.display()))?;
+    let (t, file) = s
+        .lines()
+        .filter_map(|l| {
+            let f = l.split("file=\"").nth(1)?.split('"').next()?;
+            let t: f64 = l
+                .split("timestep=\"")
+                .nth(1)?
+                .split('"')
+                .next()?
+                .parse()
+                .ok()?;
+            Some((t, f.to_string()))
+        })
+        .last()
+        .ok_or_else(|| format!("{}: no snapshot listed", pvd.display()))?;
+    let path = dir.join(&file);
+    let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let nums = |s: &str| -> Vec<f64> {
+        s.split_whitespace()
+            .filter_map(|x| x.parse().ok())
+            .collect()
+    };
+    let values = data_array(&xml, 0, &format!("Name=\"{field}\""))
+        .map(nums)
+        .ok_or_else(|| format!("{}: no point array `{field}`", path.display()))?;
+    let pts_at = xml
+        .find("<Points>")
+        .ok_or_else(|| format!("{}: no <Points>", path.display()))?;
+    let pts = data_array(&xml, pts_at, "DataArray")
+        .map(nums)
+        .ok_or_else(|| format!("{}: unreadable <Points>", path.display()))?;
+    let x = pts.iter().step_by(3).copied().collect();
+    let y = pts.iter().skip(1).step_by(3).copied().collect();
+    Ok((x, y, values, t))
+}
+
+/// Regenerates the figures and tables of `p` from the results under `output` into
+/// `manuscript/figures` and `manuscript/tables`; returns the manuscript section.
+pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Section, String> {
+    let figures = manuscript.join("figures");
+    let tables = manuscript.join("tables");
+    let mut items = Vec::new();
+    for f in &p.figures {
+        items.extend(figure(p, f, output, &figures, &tables)?);
+    }
+    for t in &p.tables {
+        items.push(metrics_table(p, t, output, &tables)?);
+    }
+    Ok(Section {
+        title: p.title.clone(),
+        text: format!(
+            "{}\n\nProblem file `problems/{}.toml`, preset `{}`, {} case(s).",
+            p.description.trim(),
+            p.name,
+            p.preset,
+            p.cases.len()
+        ),
+        items,
+    })
+}
+
+fn missing_note(rs: &[Run]) -> String {
+    let m: Vec<_> = rs
+        .iter()
+        .filter(|r| r.summary.is_none())
+        .map(|r| r.case.name.as_str())
+        .collect();
+    if m.is_empty() {
+        String::new()
+    } else {
+        format!(" No result for: {}.", m.join(", "))
+    }
+}
+
+/// Numbers per case and the verdict on the figure's claim.
+fn ours(f: &Figure, rs: &[Run]) -> String {
+    let Some(m) = &f.metric else {
+        return format!("{} case(s) drawn.{}", rs.len(), missing_note(rs));
+    };
+    let mut parts: Vec<String> = rs
+        .iter()
+        .map(|r| match (&r.summary, metric(r, m)) {
+            (_, Some(v)) => format!("{}: {}", label(r.case, &f.label), fmt(v)),
+            (Some(s), None) => format!(
+                "{}: {:?} at t = {:.3} ({})",
+                label(r.case, &f.label),
+                s.status,
+                s.final_time,
+                s.reason.clone().unwrap_or_default()
+            ),
+            (None, None) => format!("{}: no result", label(r.case, &f.label)),
+        })
+        .collect();
+    let mut text = format!("`{m}`: {}.", parts.drain(..).collect::<Vec<_>>().join("; "));
+    if f.converges {
+        let key = f.label.last().expect("validated");
+        let mut pts: Vec<(f64, Option<f64>)> = rs
+            .iter()
+            .map(|r| (param_f64(r.case, key), metric(r, m)))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let vals: Vec<f64> = pts.iter().filter_map(|x| x.1).collect();
+        if vals.len() < pts.len() || vals.len() < 2 {
+            text += " The convergence claim cannot be judged: results are missing.";
+        } else if vals.windows(2).all(|w| w[1] < w[0]) {
+            text += &format!(" Reproduced: `{m}` decreases as `{key}` grows.");
+        } else {
+            text += &format!(
+                " **Not reproduced:** `{m}` does not decrease monotonically as `{key}` grows ({}).",
+                vals.iter().map(|v| fmt(*v)).collect::<Vec<_>>().join(", ")
+            );
+        }
+    }
+    if let Some((lo, hi)) = &f.lower_than {
+        // Within the figure's cases.
+        let mean = |s: &Select| {
+            let v: Vec<f64> = rs
+                .iter()
+                .filter(|r| s.matches(r.case))
+                .filter_map(|r| metric(r, m))
+                .collect();
+            (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+        };
+        match (mean(lo), mean(hi)) {
+            (Some(a), Some(b)) if a < b => {
+                text += &format!(" Reproduced: {} < {} (ratio {:.2}).", fmt(a), fmt(b), b / a)
+            }
+            (Some(a), Some(b)) => {
+                text += &format!(
+                    " **Not reproduced:** the case the paper finds better has {} against {}.",
+                    fmt(a),
+                    fmt(b)
+                )
+            }
+            _ => text += " The claim cannot be judged: results are missing.",
+        }
+    }
+    text + &missing_note(rs)
+}
+
+fn figure(
+    p: &Problem,
+    f: &Figure,
+    output: &Path,
+    figures: &Path,
+    tables: &Path,
+) -> Result<Vec<Item>, String> {
+    let rs = runs(output, p, &f.select);
+    let stem = figures.join(&f.id);
+    let rel = |id: &str| format!("figures/{id}.png");
+    let fig_item = |id: &str, caption: &str, ours: String| Item::Figure {
+        path: rel(id),
+        caption: caption.to_string(),
+        paper: f.paper.clone(),
+        ours,
+    };
+    let caption = if f.caption.is_empty() {
+        f.title.clone()
+    } else {
+        f.caption.clone()
+    };
+    match &f.kind {
+        FigureKind::Timeseries { y, exact } => {
+            let mut series = Vec::new();
+            for r in rs
+                .iter()
+                .filter(|r| r.entry.dir.join("timeseries.csv").exists())
+            {
+                let (t, v) = timeseries(&r.entry.dir, y)?;
+                if series.is_empty() {
+                    if let Some(ex) = exact {
+                        let (t, v) = timeseries(&r.entry.dir, ex)?;
+                        series.push(Series {
+                            label: "exact".into(),
+                            x: t,
+                            y: v,
+                            style: SeriesStyle::Dashed,
+                        });
+                    }
+                }
+                series.push(Series {
+                    label: label(r.case, &f.label),
+                    x: t,
+                    y: v,
+                    style: SeriesStyle::Line,
+                });
+            }
+            report::line_figure(
+                &report::LineFigure {
+                    title: f.title.clone(),
+                    x_label: "t (s)".into(),
+                    y_label: f.y_label.clone().unwrap_or_else(|| y.clone()),
+                    log_x: false,
+                    log_y: f.log_y,
+                    series,
+                },
+                &stem,
+            )?;
+            Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
+        }
+        FigureKind::Particles { field } => {
+            let Some(r) = rs.iter().find(|r| r.summary.is_some()) else {
+                report::particle_figure(
+                    &report::ScatterField {
+                        title: format!("{} (no result)", f.title),
+                        x: vec![],
+                        y: vec![],
+                        value: vec![],
+                        value_label: field.clone(),
+                        range: None,
+                        aspect_equal: true,
+                    },
+                    &stem,
+                )?;
+                return Ok(vec![fig_item(&f.id, &caption, missing_note(&rs))]);
+            };
+            let (x, y, v, t) = last_snapshot(&r.entry.dir, field)?;
+            let (lo, hi) = v
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+                    (a.min(x), b.max(x))
+                });
+            report::particle_figure(
+                &report::ScatterField {
+                    title: format!("{} (t = {t:.2} s)", f.title),
+                    x,
+                    y,
+                    value: v,
+                    value_label: format!("{field} (Pa)"),
+                    range: None,
+                    aspect_equal: true,
+                },
+                &stem,
+            )?;
+            Ok(vec![fig_item(
+                &f.id,
+                &caption,
+                format!(
+                    "case {} at t = {t:.3} s: {field} from {} to {}. {}",
+                    r.case.name,
+                    fmt(lo),
+                    fmt(hi),
+                    ours(f, std::slice::from_ref(r))
+                ),
+            )])
+        }
+        FigureKind::Trade { x } => trade(f, &rs, x, figures, tables, &caption),
+        FigureKind::Stability { x, max } => stability(f, &rs, x, *max, figures, tables, &caption),
+    }
+}
+
+/// Error against wall time and against particle-steps, the Pareto front, and a table
+/// with the observed order of convergence of each group along resolution `res`.
+fn trade(
+    f: &Figure,
+    rs: &[Run],
+    res: &str,
+    figures: &Path,
+    tables: &Path,
+    caption: &str,
+) -> Result<Vec<Item>, String> {
+    let m = f.metric.as_deref().expect("validated");
+    let done: Vec<(&Run, f64, f64, f64)> = rs
+        .iter()
+        .filter_map(|r| {
+            let s = r.summary.as_ref()?;
+            let e = metric(r, m)?;
+            Some((r, e, s.wall_seconds, s.particles as f64 * s.steps as f64))
+        })
+        .collect();
+    let mut items = Vec::new();
+    for (suffix, what, idx) in [
+        ("wall", "wall time (s)", 0),
+        ("steps", "particle-steps (-)", 1),
+    ] {
+        let id = format!("{}_{suffix}", f.id);
+        let points = done
+            .iter()
+            .map(|(r, e, w, ps)| {
+                (
+                    group(r.case, &f.label),
+                    format!("{res}={}", r.case.params.0[res]),
+                    if idx == 0 { *w } else { *ps },
+                    *e,
+                )
+            })
+            .collect();
+        report::pareto_figure(
+            &report::ParetoFigure {
+                title: format!("{}: {m} against {what}", f.title),
+                x_label: what.into(),
+                y_label: f.y_label.clone().unwrap_or_else(|| format!("{m} (-)")),
+                points,
+                log_x: true,
+                log_y: true,
+            },
+            &figures.join(&id),
+        )?;
+        let front = report::pareto_front(
+            &done
+                .iter()
+                .map(|d| (if idx == 0 { d.2 } else { d.3 }, d.1))
+                .collect::<Vec<_>>(),
+        );
+        let names: Vec<String> = front
+            .iter()
+            .map(|&i| {
+                format!(
+                    "{} {res}={}",
+                    group(done[i].0.case, &f.label),
+                    done[i].0.case.params.0[res]
+                )
+            })
+            .collect();
+        items.push(Item::Figure {
+            path: format!("figures/{id}.png"),
+            caption: format!("{caption} ({what})"),
+            paper: f.paper.clone(),
+            ours: format!(
+                "Pareto front ({what}): {}.{}",
+                if names.is_empty() {
+                    "none".into()
+                } else {
+                    names.join("; ")
+                },
+                missing_note(rs)
+            ),
+        });
+    }
+    // The table, with orders of convergence per group along `res`.
+    let mut groups: BTreeMap<String, Vec<&(&Run, f64, f64, f64)>> = BTreeMap::new();
+    for d in &done {
+        groups.entry(group(d.0.case, &f.label)).or_default().push(d);
+    }
+    let front_w = report::pareto_front(&done.iter().map(|d| (d.2, d.1)).collect::<Vec<_>>());
+    let mut rows = Vec::new();
+    let mut notes = Vec::new();
+    for (g, mut ds) in groups {
+        ds.sort_by(|a, b| param_f64(a.0.case, res).total_cmp(&param_f64(b.0.case, res)));
+        let h: Vec<f64> = ds.iter().map(|d| 1.0 / param_f64(d.0.case, res)).collect();
+        let e: Vec<f64> = ds.iter().map(|d| d.1).collect();
+        let orders = report::observed_order(&h, &e);
+        for (i, d) in ds.iter().enumerate() {
+            let k = done
+                .iter()
+                .position(|x| std::ptr::eq(x.0, d.0))
+                .unwrap_or(usize::MAX);
+            rows.push(vec![
+                g.clone(),
+                d.0.case.params.0[res].to_string(),
+                d.0.summary
+                    .as_ref()
+                    .map(|s| s.particles.to_string())
+                    .unwrap_or_default(),
+                format!("{:.2}", d.2),
+                fmt(d.3),
+                fmt(d.1),
+                if i == 0 {
+                    "-".into()
+                } else {
+                    orders[i - 1]
+                        .map(|o| format!("{o:.2}"))
+                        .unwrap_or_else(|| "n/a".into())
+                },
+                if front_w.contains(&k) {
+                    "yes".into()
+                } else {
+                    String::new()
+                },
+            ]);
+        }
+        let os: Vec<f64> = orders.iter().flatten().copied().collect();
+        if os.len() >= 2 {
+            let sign_change = os.windows(2).any(|w| w[0].signum() != w[1].signum());
+            let spread = os
+                .windows(2)
+                .any(|w| (w[0] - w[1]).abs() > 0.5 * w[0].abs().max(w[1].abs()));
+            if sign_change || spread {
+                notes.push(format!(
+                    "{g}: orders {} {}: not in the asymptotic range.",
+                    os.iter()
+                        .map(|o| format!("{o:.2}"))
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                    if sign_change {
+                        "change sign"
+                    } else {
+                        "differ by more than 50%"
+                    }
+                ));
+            }
+        } else if os.len() == 1 {
+            notes.push(format!(
+                "{g}: one order ({:.2}) only: the asymptotic range cannot be judged.",
+                os[0]
+            ));
+        }
+    }
+    report::write_table(
+        &report::Table {
+            title: format!("{}: {m}, cost and observed order along {res}", f.title),
+            headers: [
+                "scheme",
+                res,
+                "particles",
+                "wall (s)",
+                "particle-steps",
+                m,
+                "order",
+                "Pareto (wall)",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect(),
+            rows,
+        },
+        &tables.join(&f.id),
+    )?;
+    items.push(Item::Table {
+        md_path: format!("tables/{}.md", f.id),
+        caption: format!("{caption}: error, cost and observed order of convergence (order between consecutive {res})."),
+    });
+    if !notes.is_empty() {
+        items.push(Item::Text(notes.join(" ")));
+    }
+    Ok(items)
+}
+
+/// Outcome of one case for a stability map.
+fn outcome(r: &Run, m: &str, max: f64) -> (Outcome, String) {
+    match &r.summary {
+        None => (Outcome::Missing, "no result".into()),
+        Some(s) if s.status == Status::Diverged => (
+            Outcome::Diverged,
+            format!(
+                "diverged at t = {:.3}: {}",
+                s.final_time,
+                s.reason.clone().unwrap_or_default()
+            ),
+        ),
+        Some(s) => match s.metrics.get(m) {
+            Some(v) if v.is_finite() && *v <= max => {
+                (Outcome::Stable, format!("{m} = {}", fmt(*v)))
+            }
+            Some(v) => (Outcome::Inaccurate, format!("{m} = {} > {max}", fmt(*v))),
+            None => (Outcome::Missing, format!("no `{m}`")),
+        },
+    }
+}
+
+fn stability(
+    f: &Figure,
+    rs: &[Run],
+    x: &str,
+    max: f64,
+    figures: &Path,
+    tables: &Path,
+    caption: &str,
+) -> Result<Vec<Item>, String> {
+    let m = f.metric.as_deref().expect("validated");
+    let mut xs: Vec<(f64, String)> = Vec::new();
+    let mut ys: Vec<String> = Vec::new();
+    for r in rs {
+        let v = (param_f64(r.case, x), r.case.params.0[x].to_string());
+        if !xs.iter().any(|a| a.1 == v.1) {
+            xs.push(v);
+        }
+        let g = group(r.case, &f.label);
+        if !ys.contains(&g) {
+            ys.push(g);
+        }
+    }
+    xs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut cells = Vec::new();
+    let mut rows = Vec::new();
+    let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
+    for r in rs {
+        let ix = xs
+            .iter()
+            .position(|a| a.1 == r.case.params.0[x].to_string())
+            .expect("listed");
+        let g = group(r.case, &f.label);
+        let iy = ys.iter().position(|a| *a == g).expect("listed");
+        let (o, why) = outcome(r, m, max);
+        *counts
+            .entry(match o {
+                Outcome::Stable => "stable",
+                Outcome::Inaccurate => "inaccurate",
+                Outcome::Diverged => "diverged",
+                Outcome::Missing => "missing",
+            })
+            .or_default() += 1;
+        cells.push((ix, iy, o, None));
+        rows.push(vec![
+            g,
+            xs[ix].1.clone(),
+            format!("{o:?}").to_lowercase(),
+            why,
+        ]);
+    }
+    report::outcome_map(
+        &report::OutcomeMap {
+            title: f.title.clone(),
+            x_label: x.into(),
+            y_label: f.label.join("/"),
+            x_ticks: xs.iter().map(|a| a.1.clone()).collect(),
+            y_ticks: ys,
+            cells,
+        },
+        &figures.join(&f.id),
+    )?;
+    report::write_table(
+        &report::Table {
+            title: format!("{}: outcome per case (inaccurate: {m} > {max})", f.title),
+            headers: vec![
+                f.label.join("/"),
+                x.into(),
+                "outcome".into(),
+                "detail".into(),
+            ],
+            rows,
+        },
+        &tables.join(&f.id),
+    )?;
+    Ok(vec![
+        Item::Figure {
+            path: format!("figures/{}.png", f.id),
+            caption: caption.to_string(),
+            paper: f.paper.clone(),
+            ours: counts
+                .iter()
+                .map(|(k, v)| format!("{v} {k}"))
+                .collect::<Vec<_>>()
+                .join(", ")
+                + ".",
+        },
+        Item::Table {
+            md_path: format!("tables/{}.md", f.id),
+            caption: format!("{caption}: outcome per case."),
+        },
+    ])
+}
+
+fn metrics_table(p: &Problem, t: &Table, output: &Path, tables: &Path) -> Result<Item, String> {
+    let rs = runs(output, p, &t.select);
+    let mut headers: Vec<String> = vec!["case".into()];
+    headers.extend(t.columns.iter().cloned());
+    headers.push("status".into());
+    headers.extend(t.metrics.iter().cloned());
+    headers.push("wall (s)".into());
+    let rows = rs
+        .iter()
+        .map(|r| {
+            let mut row = vec![r.case.name.clone()];
+            row.extend(t.columns.iter().map(|c| r.case.params.0[c].to_string()));
+            row.push(
+                r.summary
+                    .as_ref()
+                    .map(|s| format!("{:?}", s.status).to_lowercase())
+                    .unwrap_or_else(|| "missing".into()),
+            );
+            row.extend(
+                t.metrics
+                    .iter()
+                    .map(|m| metric(r, m).map(fmt).unwrap_or_else(|| "-".into())),
+            );
+            row.push(
+                r.summary
+                    .as_ref()
+                    .map(|s| format!("{:.2}", s.wall_seconds))
+                    .unwrap_or_default(),
+            );
+            row
+        })
+        .collect();
+    report::write_table(
+        &report::Table {
+            title: t.title.clone(),
+            headers,
+            rows,
+        },
+        &tables.join(&t.id),
+    )?;
+    Ok(Item::Table {
+        md_path: format!("tables/{}.md", t.id),
+        caption: if t.caption.is_empty() {
+            t.title.clone()
+        } else {
+            t.caption.clone()
+        },
+    })
+}

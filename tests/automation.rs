@@ -1,0 +1,352 @@
+//! Reliability of the automation half: the runner, the cache, the registry's errors and
+//! `check`, on tiny Taylor-Green problems written by each test into a temporary folder.
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_sphrepro");
+
+struct Env {
+    _tmp: tempfile::TempDir,
+    root: PathBuf,
+}
+
+impl Env {
+    /// A folder with `problems/tiny.toml` holding `toml`.
+    fn new(toml: &str) -> Self {
+        let tmp = tempfile::tempdir().unwrap();
+        let root = tmp.path().to_path_buf();
+        std::fs::create_dir_all(root.join("problems")).unwrap();
+        std::fs::write(root.join("problems/tiny.toml"), toml).unwrap();
+        Env { _tmp: tmp, root }
+    }
+    fn cmd(&self, args: &[&str]) -> Command {
+        let mut c = Command::new(BIN);
+        c.current_dir(&self.root).args(args).args([
+            "--problems",
+            "problems",
+            "--output",
+            "output",
+            "--manuscript",
+            "manuscript",
+        ]);
+        c
+    }
+    fn run(&self, args: &[&str]) -> Output {
+        self.cmd(args).output().unwrap()
+    }
+    fn case_dir(&self, name: &str) -> PathBuf {
+        let dir = self.root.join("output/tiny");
+        std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .find(|p| {
+                p.is_dir()
+                    && p.file_name()
+                        .unwrap()
+                        .to_string_lossy()
+                        .rsplit_once('-')
+                        .is_some_and(|(n, _)| n == name)
+            })
+            .unwrap_or_else(|| panic!("no folder for case {name}"))
+    }
+    fn summary(&self, name: &str) -> serde_json::Value {
+        let s = std::fs::read_to_string(self.case_dir(name).join("summary.json")).unwrap();
+        serde_json::from_str(&s).unwrap()
+    }
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// Three named cases at nx = 12/14/16, tf as given.
+fn three_cases(tf: f64) -> String {
+    format!(
+        r#"title = "tiny"
+scene = "taylor_green"
+[params]
+tf = {tf}
+[presets.quick]
+[[cases]]
+name = "a"
+params = {{ nx = 12 }}
+[[cases]]
+name = "b"
+params = {{ nx = 14 }}
+[[cases]]
+name = "c"
+params = {{ nx = 16 }}
+[[bounds]]
+metric = "l1_velocity_final"
+cases = ["a", "b", "c"]
+max = BOUND
+"#
+    )
+}
+
+#[test]
+fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
+    let src = three_cases(0.03).replace("BOUND", "1.0");
+    let env = Env::new(&src);
+    let o = env.run(&["run", "tiny"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let started = |n: &str| env.summary(n)["provenance"]["started"].clone();
+    let before: Vec<_> = ["a", "b", "c"].iter().map(|n| started(n)).collect();
+    // A second run does nothing.
+    let o = env.run(&["run", "tiny"]);
+    assert!(
+        text(&o).contains("0 case(s) to run, 3 done"),
+        "{}",
+        text(&o)
+    );
+    // Edit b's parameter: only b runs, and the dry run names the change.
+    std::fs::write(
+        env.root.join("problems/tiny.toml"),
+        src.replace("nx = 14", "nx = 15"),
+    )
+    .unwrap();
+    let o = env.run(&["run", "tiny", "--dry-run"]);
+    let t = text(&o);
+    assert!(
+        t.contains("tiny/b (stale: nx 14 -> 15)") && t.contains("1 to run"),
+        "{t}"
+    );
+    let o = env.run(&["run", "tiny"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(
+        t.contains("run     tiny/b")
+            && !t.contains("run     tiny/a")
+            && !t.contains("run     tiny/c"),
+        "{t}"
+    );
+    assert_eq!(started("a"), before[0]);
+    assert_eq!(started("c"), before[2]);
+    assert_eq!(env.summary("b")["params"]["nx"], 15);
+    // The old folder of b is reported as stale, not deleted.
+    let o = env.run(&["status"]);
+    assert!(text(&o).contains("1 stale folder(s)"), "{}", text(&o));
+
+    // check: within bounds passes; a breached bound names problem, case, metric, value, bound.
+    let o = env.run(&["check"]);
+    assert!(o.status.success(), "{}", text(&o));
+    std::fs::write(
+        env.root.join("problems/tiny.toml"),
+        src.replace("nx = 14", "nx = 15")
+            .replace("max = 1.0", "max = 1e-9"),
+    )
+    .unwrap();
+    let o = env.run(&["check"]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(
+        t.contains("tiny/a") && t.contains("l1_velocity_final") && t.contains("> max 1e-9"),
+        "{t}"
+    );
+}
+
+#[test]
+fn a_killed_run_is_not_done_and_is_repeated() {
+    use std::os::unix::process::CommandExt;
+    let env = Env::new(
+        r#"title = "one slow case"
+scene = "taylor_green"
+[presets.quick]
+[[cases]]
+name = "a"
+params = { nx = 16, tf = 20.0 }
+"#,
+    );
+    let mut child = env
+        .cmd(&["run", "tiny", "--jobs", "1"])
+        .process_group(0)
+        .spawn()
+        .unwrap();
+    // Wait until the simulation reports progress, then kill runner and case at once.
+    let t0 = std::time::Instant::now();
+    let progress = loop {
+        let p = std::fs::read_dir(env.root.join("output/tiny"))
+            .ok()
+            .and_then(|mut d| {
+                d.find_map(|e| {
+                    e.ok()
+                        .map(|e| e.path().join("progress"))
+                        .filter(|p| p.exists())
+                })
+            });
+        if let Some(p) = p {
+            break p;
+        }
+        assert!(t0.elapsed().as_secs() < 60, "no progress file");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    let pgid = child.id();
+    Command::new("kill")
+        .args(["-KILL", "--", &format!("-{pgid}")])
+        .status()
+        .unwrap();
+    let _ = child.wait();
+    let dir = progress.parent().unwrap();
+    assert!(
+        !dir.join("summary.json").exists(),
+        "killed run left a summary"
+    );
+    let o = env.run(&["status"]);
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("failed") && t.contains("a  (no summary"), "{t}");
+    // The next run repeats it, taking over the dead runner's lock.
+    let o = env.run(&["run", "tiny"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("run     tiny/a"), "{t}");
+    assert_eq!(env.summary("a")["status"], "completed");
+}
+
+#[test]
+fn two_runs_at_once_simulate_each_case_once() {
+    let env = Env::new(&three_cases(0.3).replace("BOUND", "1.0"));
+    let spawn = || {
+        env.cmd(&["run", "tiny"])
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let (a, b) = (spawn(), spawn());
+    let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
+    assert!(
+        a.status.success() && b.status.success(),
+        "{}\n{}",
+        text(&a),
+        text(&b)
+    );
+    let all = text(&a) + &text(&b);
+    for n in ["a", "b", "c"] {
+        let done = all.matches(&format!("done    tiny/{n} ")).count();
+        assert_eq!(done, 1, "case {n} simulated {done} times:\n{all}");
+        assert_eq!(env.summary(n)["status"], "completed");
+    }
+    assert!(env.run(&["status"]).status.success());
+}
+
+const VALID: &str = r#"title = "tiny"
+scene = "taylor_green"
+[params]
+tf = 0.02
+[presets.quick]
+nx = [12]
+[[cases]]
+name = "a-nx{nx}"
+grid = { nx = "$nx" }
+[[cases]]
+name = "b"
+params = { nx = 14 }
+[[figures]]
+id = "f"
+kind = "timeseries"
+title = "t"
+y = "u_max"
+cases = ["a-*"]
+metric = "l1_velocity_final"
+"#;
+
+#[test]
+fn invalid_problem_files_are_refused_with_file_and_line() {
+    let bad: &[(&str, &str, &str, &str)] = &[
+        // (what, from, to, expected word; the expected line is where `to` lands)
+        ("malformed", "tf = 0.02", "tf = = 0.02", "tiny.toml:4"),
+        (
+            "unknown key",
+            "kind = \"timeseries\"",
+            "kind = \"timeseries\"\ncolour = 1",
+            "colour",
+        ),
+        (
+            "unknown scene",
+            "\"taylor_green\"",
+            "\"no_such_scene\"",
+            "no_such_scene",
+        ),
+        (
+            "unknown parameter",
+            "params = { nx = 14 }",
+            "params = { nx = 14, frob = 2 }",
+            "frob",
+        ),
+        (
+            "wrong type",
+            "params = { nx = 14 }",
+            "params = { nx = \"fourteen\" }",
+            "nx",
+        ),
+        (
+            "duplicate case",
+            "name = \"b\"",
+            "name = \"a-nx12\"",
+            "two cases",
+        ),
+        (
+            "missing case",
+            "cases = [\"a-*\"]",
+            "cases = [\"zz\"]",
+            "zz",
+        ),
+        (
+            "missing metric",
+            "metric = \"l1_velocity_final\"",
+            "metric = \"l7\"",
+            "l7",
+        ),
+    ];
+    let ok = Env::new(VALID);
+    assert!(ok.run(&["run", "tiny", "--dry-run"]).status.success());
+    for (what, from, to, word) in bad {
+        assert!(VALID.contains(from), "{what}");
+        let src = VALID.replacen(from, to, 1);
+        let end = src.find(to).unwrap() + to.len();
+        let line = src[..end].matches('\n').count() + 1;
+        let env = Env::new(&src);
+        let o = env.run(&["run", "tiny"]);
+        let t = text(&o);
+        assert!(!o.status.success(), "{what}: accepted\n{t}");
+        assert!(t.contains(word), "{what}: no `{word}` in: {t}");
+        assert!(
+            t.contains(&format!("tiny.toml:{line}"))
+                || *what == "missing case"
+                || *what == "missing metric"
+                || *what == "duplicate case",
+            "{what}: no line {line} in: {t}"
+        );
+        assert!(t.contains("tiny.toml:"), "{what}: no file in {t}");
+        assert!(!env.root.join("output").exists(), "{what}: wrote output");
+        assert!(!t.contains("panicked"), "{what}: {t}");
+    }
+}
+
+#[test]
+fn an_unwritable_output_folder_is_reported_with_its_path() {
+    let env = Env::new(VALID);
+    std::fs::write(env.root.join("afile"), "x").unwrap();
+    let o = Command::new(BIN)
+        .current_dir(&env.root)
+        .args([
+            "run",
+            "tiny",
+            "--problems",
+            "problems",
+            "--output",
+            "afile/out",
+        ])
+        .output()
+        .unwrap();
+    let t = text(&o);
+    assert!(!o.status.success(), "{t}");
+    assert!(t.contains("afile/out") && !t.contains("panicked"), "{t}");
+}
