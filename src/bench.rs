@@ -30,6 +30,8 @@ pub struct BenchResult {
     pub bytes_per_particle: f64,
     /// Mean IPST iterations per step (0 without IPST).
     pub ipst_iterations_mean: f64,
+    /// Share of the timed steps spent in each phase.
+    pub phase_shares: crate::solver::simulation::PhaseTimes,
 }
 
 /// The variants benchmarked: (name, scheme, pst).
@@ -67,6 +69,7 @@ pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<Ben
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
+    sim.times = Default::default();
     let t0 = Instant::now();
     let mut ipst = 0usize;
     for _ in 0..steps {
@@ -87,6 +90,7 @@ pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<Ben
         peak_rss_bytes: hwm,
         bytes_per_particle: hwm.saturating_sub(rss0) as f64 / n as f64,
         ipst_iterations_mean: ipst as f64 / steps as f64,
+        phase_shares: sim.times.scaled(1.0 / seconds),
     })
 }
 
@@ -99,7 +103,7 @@ pub fn default_steps(n: usize) -> u64 {
 /// `edac` on the same size and threads, and the two-thread speed-up.
 pub fn table(results: &[BenchResult]) -> String {
     let mut s = String::from(
-        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in results {
         let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
@@ -113,19 +117,30 @@ pub fn table(results: &[BenchResult]) -> String {
         } else {
             String::new()
         };
+        let p = &r.phase_shares;
+        let shares = format!(
+            "{:.0}/{:.0}/{:.0}/{:.0}/{:.0}/{:.0}",
+            100.0 * p.neighbours,
+            100.0 * p.density,
+            100.0 * p.pressure,
+            100.0 * p.accelerations,
+            100.0 * p.ipst,
+            100.0 * p.integrate
+        );
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.0} | {:.0} | {} | {} | {:.2} |\n",
+            "| {} | {} | {} | {} | {} | {:.3} | {:.0} | {:.0} | {} | {} | {:.2} | {} |\n",
             r.variant,
             r.nx,
             r.particles,
             r.threads,
             r.steps,
             r.particle_steps_per_second / 1e6,
-            1e9 / r.particle_steps_per_second * r.threads as f64 / r.threads as f64,
+            1e9 / r.particle_steps_per_second,
             r.bytes_per_particle,
             cost,
             speedup,
-            r.ipst_iterations_mean
+            r.ipst_iterations_mean,
+            shares
         ));
     }
     s

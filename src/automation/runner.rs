@@ -113,15 +113,6 @@ pub fn split_cores(jobs: Option<usize>, tasks: usize) -> (usize, usize) {
     (jobs, (cores / jobs).max(1))
 }
 
-/// Whether this binary's `simulate` takes `--checkpoint-every`.
-fn simulate_checkpoints(exe: &Path) -> bool {
-    Command::new(exe)
-        .args(["simulate", "--help"])
-        .output()
-        .map(|o| String::from_utf8_lossy(&o.stdout).contains("--checkpoint-every"))
-        .unwrap_or(false)
-}
-
 /// Prints a line above the progress bars.
 fn say(mp: &MultiProgress, line: String) {
     mp.suspend(|| println!("{line}"));
@@ -132,9 +123,7 @@ fn say(mp: &MultiProgress, line: String) {
 pub fn execute(tasks: Vec<Task>, opts: &Options) -> Result<Report, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot find own executable: {e}"))?;
     let (jobs, threads) = split_cores(opts.jobs, tasks.len());
-    let checkpoint = opts
-        .checkpoint_every
-        .filter(|_| !tasks.is_empty() && simulate_checkpoints(&exe));
+    let checkpoint = opts.checkpoint_every;
     let mp = MultiProgress::with_draw_target(if std::io::stderr().is_terminal() {
         ProgressDrawTarget::stderr()
     } else {

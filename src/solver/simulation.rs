@@ -56,6 +56,45 @@ pub struct State<const D: usize> {
     pub ipst_iterations: usize,
 }
 
+/// Wall-clock seconds spent in each phase of the step, summed over the run (a few clock
+/// reads per step; reported by `sphrepro bench`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct PhaseTimes {
+    /// Kicks, drift and the blow-up check.
+    pub integrate: f64,
+    /// Wrapping, binning, reordering and the neighbour list with its kernel values.
+    pub neighbours: f64,
+    /// Summation density.
+    pub density: f64,
+    /// Density and pressure rates and their update (pass A).
+    pub pressure: f64,
+    /// Accelerations and homogenisation (pass B).
+    pub accelerations: f64,
+    /// Iterative shifting.
+    pub ipst: f64,
+}
+
+impl PhaseTimes {
+    /// Every phase multiplied by `f` (e.g. 1 / total, for shares).
+    pub fn scaled(&self, f: f64) -> Self {
+        Self {
+            integrate: self.integrate * f,
+            neighbours: self.neighbours * f,
+            density: self.density * f,
+            pressure: self.pressure * f,
+            accelerations: self.accelerations * f,
+            ipst: self.ipst * f,
+        }
+    }
+}
+
+/// Adds the time since `start` to `acc` and returns now.
+fn lap(start: std::time::Instant, acc: &mut f64) -> std::time::Instant {
+    let now = std::time::Instant::now();
+    *acc += (now - start).as_secs_f64();
+    now
+}
+
 /// One simulation of one fluid body in a domain.
 pub struct Simulation<const D: usize> {
     /// The box.
@@ -69,6 +108,8 @@ pub struct Simulation<const D: usize> {
     cells: CellList<D>,
     neighbours: KernelList<D>,
     passes: FluidPasses<D>,
+    /// Time per phase of the step, summed over the run.
+    pub times: PhaseTimes,
 }
 
 impl<const D: usize> Simulation<D> {
@@ -110,7 +151,8 @@ impl<const D: usize> Simulation<D> {
         }
         state.scheme = scheme;
         let passes = FluidPasses::new();
-        let mut sim = Self { domain, kernel, time_settings, state, cells, neighbours, passes };
+        let mut sim =
+            Self { domain, kernel, time_settings, state, cells, neighbours, passes, times: PhaseTimes::default() };
         sim.state.u_max = sim.max_speed();
         // Initial accelerations for the first half kick; the pressure is the initial one.
         if sim.state.scheme.density == DensityModel::Summation {
@@ -190,20 +232,18 @@ impl<const D: usize> Simulation<D> {
     }
 
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
+        let clock = std::time::Instant::now();
         let st = &mut self.state;
         self.passes.accelerations(&st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt_nominal);
-        st.ipst_iterations = self.passes.ipst(
-            &st.fluid,
-            &self.neighbours,
-            &self.kernel,
-            &st.scheme,
-            &mut st.rates,
-            dt_nominal,
-        );
+        let clock = lap(clock, &mut self.times.accelerations);
+        st.ipst_iterations =
+            self.passes.ipst(&st.fluid, &self.neighbours, &self.kernel, &st.scheme, &mut st.rates, dt_nominal);
+        lap(clock, &mut self.times.ipst);
     }
 
     /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60).
     pub fn step(&mut self, max_dt: f64) -> Result<(), Divergence> {
+        let clock = std::time::Instant::now();
         let dt_nominal = self.nominal_dt();
         let dt = dt_nominal.min(max_dt);
         {
@@ -216,32 +256,27 @@ impl<const D: usize> Simulation<D> {
             let Fluid { x, u, u_hat, .. } = f;
             integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
-        Self::rebuild(
-            &self.domain,
-            &self.kernel,
-            &mut self.cells,
-            &mut self.neighbours,
-            &mut self.state.fluid,
-        );
+        let clock = lap(clock, &mut self.times.integrate);
+        Self::rebuild(&self.domain, &self.kernel, &mut self.cells, &mut self.neighbours, &mut self.state.fluid);
+        let mut clock = lap(clock, &mut self.times.neighbours);
         {
             let st = &mut self.state;
             if st.scheme.density == DensityModel::Summation {
                 FluidPasses::summation_density(&mut st.fluid, &self.neighbours);
+                clock = lap(clock, &mut self.times.density);
             }
-            self.passes.update_density_and_pressure(
-                &mut st.fluid,
-                &self.neighbours,
-                &st.scheme,
-                &mut st.rates,
-                dt,
-            );
+            self.passes.update_density_and_pressure(&mut st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt);
         }
+        lap(clock, &mut self.times.pressure);
         self.evaluate_accelerations(dt_nominal);
+        let clock = std::time::Instant::now();
         let st = &mut self.state;
         integrator::kick(&mut st.fluid.u, &st.rates.du, dt);
         st.time += dt;
         st.steps += 1;
-        self.check()
+        let result = self.check();
+        lap(clock, &mut self.times.integrate);
+        result
     }
 
     /// Steps until the time reaches `t_stop` (without shortening steps for it, so output
