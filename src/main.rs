@@ -216,20 +216,14 @@ fn main() -> ExitCode {
             &args.preset,
             &problem,
             &args.options(),
-            &RunFlags {
-                plot_only: args.plot_only,
-                manuscript: false,
-            },
+            &RunFlags { plot_only: args.plot_only, manuscript: false },
         )),
         Command::Reproduce { args } => ExitCode::from(commands::run(
             &args.dirs.dirs(),
             &args.preset,
             &[],
             &args.options(),
-            &RunFlags {
-                plot_only: args.plot_only,
-                manuscript: true,
-            },
+            &RunFlags { plot_only: args.plot_only, manuscript: true },
         )),
         Command::Status { preset, dirs } => ExitCode::from(commands::status(&dirs.dirs(), &preset)),
         Command::Check { preset, dirs } => ExitCode::from(commands::check(&dirs.dirs(), &preset)),

@@ -58,11 +58,7 @@ impl Env {
 }
 
 fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
+    format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
 
 /// Three named cases at nx = 12/14/16, tf as given.
@@ -100,30 +96,17 @@ fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
     let before: Vec<_> = ["a", "b", "c"].iter().map(|n| started(n)).collect();
     // A second run does nothing.
     let o = env.run(&["run", "tiny"]);
-    assert!(
-        text(&o).contains("0 case(s) to run, 3 done"),
-        "{}",
-        text(&o)
-    );
+    assert!(text(&o).contains("0 case(s) to run, 3 done"), "{}", text(&o));
     // Edit b's parameter: only b runs, and the dry run names the change.
-    std::fs::write(
-        env.root.join("problems/tiny.toml"),
-        src.replace("nx = 14", "nx = 15"),
-    )
-    .unwrap();
+    std::fs::write(env.root.join("problems/tiny.toml"), src.replace("nx = 14", "nx = 15")).unwrap();
     let o = env.run(&["run", "tiny", "--dry-run"]);
     let t = text(&o);
-    assert!(
-        t.contains("tiny/b (stale: nx 14 -> 15)") && t.contains("1 to run"),
-        "{t}"
-    );
+    assert!(t.contains("tiny/b (stale: nx 14 -> 15)") && t.contains("1 to run"), "{t}");
     let o = env.run(&["run", "tiny"]);
     let t = text(&o);
     assert!(o.status.success(), "{t}");
     assert!(
-        t.contains("run     tiny/b")
-            && !t.contains("run     tiny/a")
-            && !t.contains("run     tiny/c"),
+        t.contains("run     tiny/b") && !t.contains("run     tiny/a") && !t.contains("run     tiny/c"),
         "{t}"
     );
     assert_eq!(started("a"), before[0]);
@@ -138,17 +121,13 @@ fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
     assert!(o.status.success(), "{}", text(&o));
     std::fs::write(
         env.root.join("problems/tiny.toml"),
-        src.replace("nx = 14", "nx = 15")
-            .replace("max = 1.0", "max = 1e-9"),
+        src.replace("nx = 14", "nx = 15").replace("max = 1.0", "max = 1e-9"),
     )
     .unwrap();
     let o = env.run(&["check"]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
-    assert!(
-        t.contains("tiny/a") && t.contains("l1_velocity_final") && t.contains("> max 1e-9"),
-        "{t}"
-    );
+    assert!(t.contains("tiny/a") && t.contains("l1_velocity_final") && t.contains("> max 1e-9"), "{t}");
 }
 
 #[test]
@@ -163,23 +142,13 @@ name = "a"
 params = { nx = 16, tf = 20.0 }
 "#,
     );
-    let mut child = env
-        .cmd(&["run", "tiny", "--jobs", "1"])
-        .process_group(0)
-        .spawn()
-        .unwrap();
+    let mut child = env.cmd(&["run", "tiny", "--jobs", "1"]).process_group(0).spawn().unwrap();
     // Wait until the simulation reports progress, then kill runner and case at once.
     let t0 = std::time::Instant::now();
     let progress = loop {
-        let p = std::fs::read_dir(env.root.join("output/tiny"))
-            .ok()
-            .and_then(|mut d| {
-                d.find_map(|e| {
-                    e.ok()
-                        .map(|e| e.path().join("progress"))
-                        .filter(|p| p.exists())
-                })
-            });
+        let p = std::fs::read_dir(env.root.join("output/tiny")).ok().and_then(|mut d| {
+            d.find_map(|e| e.ok().map(|e| e.path().join("progress")).filter(|p| p.exists()))
+        });
         if let Some(p) = p {
             break p;
         }
@@ -187,16 +156,10 @@ params = { nx = 16, tf = 20.0 }
         std::thread::sleep(std::time::Duration::from_millis(50));
     };
     let pgid = child.id();
-    Command::new("kill")
-        .args(["-KILL", "--", &format!("-{pgid}")])
-        .status()
-        .unwrap();
+    Command::new("kill").args(["-KILL", "--", &format!("-{pgid}")]).status().unwrap();
     let _ = child.wait();
     let dir = progress.parent().unwrap();
-    assert!(
-        !dir.join("summary.json").exists(),
-        "killed run left a summary"
-    );
+    assert!(!dir.join("summary.json").exists(), "killed run left a summary");
     let o = env.run(&["status"]);
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
@@ -221,12 +184,7 @@ fn two_runs_at_once_simulate_each_case_once() {
     };
     let (a, b) = (spawn(), spawn());
     let (a, b) = (a.wait_with_output().unwrap(), b.wait_with_output().unwrap());
-    assert!(
-        a.status.success() && b.status.success(),
-        "{}\n{}",
-        text(&a),
-        text(&b)
-    );
+    assert!(a.status.success() && b.status.success(), "{}\n{}", text(&a), text(&b));
     let all = text(&a) + &text(&b);
     for n in ["a", "b", "c"] {
         let done = all.matches(&format!("done    tiny/{n} ")).count();
@@ -262,48 +220,13 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
     let bad: &[(&str, &str, &str, &str)] = &[
         // (what, from, to, expected word; the expected line is where `to` lands)
         ("malformed", "tf = 0.02", "tf = = 0.02", "tiny.toml:4"),
-        (
-            "unknown key",
-            "kind = \"timeseries\"",
-            "kind = \"timeseries\"\ncolour = 1",
-            "colour",
-        ),
-        (
-            "unknown scene",
-            "\"taylor_green\"",
-            "\"no_such_scene\"",
-            "no_such_scene",
-        ),
-        (
-            "unknown parameter",
-            "params = { nx = 14 }",
-            "params = { nx = 14, frob = 2 }",
-            "frob",
-        ),
-        (
-            "wrong type",
-            "params = { nx = 14 }",
-            "params = { nx = \"fourteen\" }",
-            "nx",
-        ),
-        (
-            "duplicate case",
-            "name = \"b\"",
-            "name = \"a-nx12\"",
-            "two cases",
-        ),
-        (
-            "missing case",
-            "cases = [\"a-*\"]",
-            "cases = [\"zz\"]",
-            "zz",
-        ),
-        (
-            "missing metric",
-            "metric = \"l1_velocity_final\"",
-            "metric = \"l7\"",
-            "l7",
-        ),
+        ("unknown key", "kind = \"timeseries\"", "kind = \"timeseries\"\ncolour = 1", "colour"),
+        ("unknown scene", "\"taylor_green\"", "\"no_such_scene\"", "no_such_scene"),
+        ("unknown parameter", "params = { nx = 14 }", "params = { nx = 14, frob = 2 }", "frob"),
+        ("wrong type", "params = { nx = 14 }", "params = { nx = \"fourteen\" }", "nx"),
+        ("duplicate case", "name = \"b\"", "name = \"a-nx12\"", "two cases"),
+        ("missing case", "cases = [\"a-*\"]", "cases = [\"zz\"]", "zz"),
+        ("missing metric", "metric = \"l1_velocity_final\"", "metric = \"l7\"", "l7"),
     ];
     let ok = Env::new(VALID);
     assert!(ok.run(&["run", "tiny", "--dry-run"]).status.success());
@@ -336,14 +259,7 @@ fn an_unwritable_output_folder_is_reported_with_its_path() {
     std::fs::write(env.root.join("afile"), "x").unwrap();
     let o = Command::new(BIN)
         .current_dir(&env.root)
-        .args([
-            "run",
-            "tiny",
-            "--problems",
-            "problems",
-            "--output",
-            "afile/out",
-        ])
+        .args(["run", "tiny", "--problems", "problems", "--output", "afile/out"])
         .output()
         .unwrap();
     let t = text(&o);

@@ -69,8 +69,7 @@ impl CaseRecord {
         if old.solver != self.solver {
             out.push(format!("solver {} -> {}", old.solver, self.solver));
         }
-        let keys: std::collections::BTreeSet<&String> =
-            old.params.keys().chain(self.params.keys()).collect();
+        let keys: std::collections::BTreeSet<&String> = old.params.keys().chain(self.params.keys()).collect();
         for k in keys {
             let (a, b) = (old.params.get(k), self.params.get(k));
             if a != b {
@@ -115,11 +114,7 @@ impl Entry {
     pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
         let record = CaseRecord::new(&problem.name, case);
         let dir = output.join(&problem.name).join(record.folder());
-        Self {
-            case: case.clone(),
-            record,
-            dir,
-        }
+        Self { case: case.clone(), record, dir }
     }
 
     /// The summary, if there is a readable one.
@@ -130,13 +125,9 @@ impl Entry {
     /// The state of this case on disk.
     pub fn state(&self) -> State {
         match Summary::read(&self.dir) {
-            Ok(s) if matches!(s.status, Status::Completed | Status::Diverged) => {
-                State::Done(s.status)
-            }
+            Ok(s) if matches!(s.status, Status::Completed | Status::Diverged) => State::Done(s.status),
             Ok(s) => State::Failed(s.reason.unwrap_or_else(|| "failed".into())),
-            Err(_) if self.dir.exists() => {
-                State::Failed("no summary: the run was killed or crashed".into())
-            }
+            Err(_) if self.dir.exists() => State::Failed("no summary: the run was killed or crashed".into()),
             Err(_) => State::Missing(self.previous_change()),
         }
     }
@@ -184,11 +175,7 @@ pub fn read_record(dir: &Path) -> Option<CaseRecord> {
 
 /// Every case of `problem` with its cache entry.
 pub fn entries(output: &Path, problem: &Problem) -> Vec<Entry> {
-    problem
-        .cases
-        .iter()
-        .map(|c| Entry::new(output, problem, c))
-        .collect()
+    problem.cases.iter().map(|c| Entry::new(output, problem, c)).collect()
 }
 
 /// Folders under `OUTPUT/<problem>/` that belong to no case of `problems` (in any of the
@@ -198,11 +185,8 @@ pub fn stale_folders(output: &Path, problem: &str, live: &[PathBuf]) -> Vec<Path
     let Ok(rd) = std::fs::read_dir(&dir) else {
         return Vec::new();
     };
-    let mut out: Vec<PathBuf> = rd
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.is_dir() && !live.contains(p))
-        .collect();
+    let mut out: Vec<PathBuf> =
+        rd.flatten().map(|e| e.path()).filter(|p| p.is_dir() && !live.contains(p)).collect();
     out.sort();
     out
 }
@@ -216,11 +200,7 @@ mod tests {
         let entry = crate::scenes::find("taylor_green").unwrap();
         let mut p = Params::defaults(&(entry.params)());
         p.0.insert("nx".into(), Value::Int(nx));
-        Case {
-            name: "a".into(),
-            scene: "taylor_green".into(),
-            params: p,
-        }
+        Case { name: "a".into(), scene: "taylor_green".into(), params: p }
     }
 
     #[test]

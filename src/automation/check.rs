@@ -140,11 +140,7 @@ pub fn status(output: &Path, problems: &[Problem]) -> StatusCounts {
                     None => format!("case {} is no longer in the problem file", r.name),
                 })
                 .unwrap_or_else(|| "no case.json".into());
-            println!(
-                "  {:<10} {}  ({why}; kept, not deleted)",
-                "stale",
-                s.display()
-            );
+            println!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
         }
     }
     println!(

@@ -40,10 +40,7 @@ fn load(dirs: &Dirs, preset: &str, only: &[String]) -> Result<Vec<Problem>, Stri
             ));
         }
     }
-    Ok(all
-        .into_iter()
-        .filter(|p| only.is_empty() || only.contains(&p.name))
-        .collect())
+    Ok(all.into_iter().filter(|p| only.is_empty() || only.contains(&p.name)).collect())
 }
 
 /// `list`: problems and their cases.
@@ -169,11 +166,7 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
 
 /// Figures, tables and (with `flags.manuscript`) manuscript.md from cached results.
 fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(), String> {
-    if problems
-        .iter()
-        .all(|p| p.figures.is_empty() && p.tables.is_empty())
-        && !flags.manuscript
-    {
+    if problems.iter().all(|p| p.figures.is_empty() && p.tables.is_empty()) && !flags.manuscript {
         return Ok(());
     }
     ensure_dir(&dirs.manuscript, "manuscript")?;
@@ -240,10 +233,7 @@ pub fn check(dirs: &Dirs, preset: &str) -> u8 {
     for b in &bad {
         println!("FAIL {}: {}", b.case, b.what);
     }
-    println!(
-        "{ok} bound(s) hold, {} breached (preset {preset})",
-        bad.len()
-    );
+    println!("{ok} bound(s) hold, {} breached (preset {preset})", bad.len());
     if bad.is_empty() {
         OK
     } else {
@@ -254,8 +244,5 @@ pub fn check(dirs: &Dirs, preset: &str) -> u8 {
 /// The cache folder of every case (for tests and tools).
 pub fn case_dirs(dirs: &Dirs, preset: &str) -> Result<Vec<PathBuf>, String> {
     let ps = load(dirs, preset, &[])?;
-    Ok(ps
-        .iter()
-        .flat_map(|p| cache::entries(&dirs.output, p).into_iter().map(|e| e.dir))
-        .collect())
+    Ok(ps.iter().flat_map(|p| cache::entries(&dirs.output, p).into_iter().map(|e| e.dir)).collect())
 }

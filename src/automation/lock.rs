@@ -40,20 +40,14 @@ impl Lock {
                 .map_err(|e| format!("{}: cannot create folder: {e}", parent.display()))?;
         }
         for _ in 0..3 {
-            match std::fs::OpenOptions::new()
-                .write(true)
-                .create_new(true)
-                .open(&path)
-            {
+            match std::fs::OpenOptions::new().write(true).create_new(true).open(&path) {
                 Ok(mut f) => {
                     f.write_all(std::process::id().to_string().as_bytes())
                         .map_err(|e| format!("{}: {e}", path.display()))?;
                     return Ok(Try::Taken(Lock { path }));
                 }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                    let pid = std::fs::read_to_string(&path)
-                        .ok()
-                        .and_then(|s| s.trim().parse::<u32>().ok());
+                    let pid = std::fs::read_to_string(&path).ok().and_then(|s| s.trim().parse::<u32>().ok());
                     match pid {
                         Some(pid) if alive(pid) => return Ok(Try::Held(pid)),
                         // Empty: its owner may be between create and write; wait.

@@ -40,13 +40,7 @@ mod tests {
             }
         }
         let mut bad = Vec::new();
-        walk(
-            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/solver"),
-            &mut bad,
-        );
-        assert!(
-            bad.is_empty(),
-            "solver files importing scenes/automation: {bad:?}"
-        );
+        walk(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/solver"), &mut bad);
+        assert!(bad.is_empty(), "solver files importing scenes/automation: {bad:?}");
     }
 }

@@ -154,16 +154,9 @@ pub struct Select {
 impl Select {
     /// Whether `case` is selected.
     pub fn matches(&self, case: &Case) -> bool {
-        let by_name = self.cases.is_empty()
-            || self
-                .cases
-                .iter()
-                .any(|g| glob_matches(g, &case.name).unwrap_or(false));
-        by_name
-            && self
-                .where_
-                .iter()
-                .all(|(k, v)| case.params.0.get(k).is_some_and(|c| values_equal(c, v)))
+        let by_name =
+            self.cases.is_empty() || self.cases.iter().any(|g| glob_matches(g, &case.name).unwrap_or(false));
+        by_name && self.where_.iter().all(|(k, v)| case.params.0.get(k).is_some_and(|c| values_equal(c, v)))
     }
 
     /// The selected cases, in problem order.
@@ -328,11 +321,7 @@ impl Loc<'_> {
         self.src[..offset.min(self.src.len())].matches('\n').count() + 1
     }
     fn err(&self, span: std::ops::Range<usize>, key: &str, msg: impl std::fmt::Display) -> String {
-        format!(
-            "{}:{}: `{key}`: {msg}",
-            self.path.display(),
-            self.line(span.start)
-        )
+        format!("{}:{}: `{key}`: {msg}", self.path.display(), self.line(span.start))
     }
 }
 
@@ -376,18 +365,10 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
     let loc = Loc { path, src };
     let file: ProblemFile = toml::from_str(src).map_err(|e| {
         let line = e.span().map(|s| loc.line(s.start)).unwrap_or(1);
-        format!(
-            "{}:{line}: {}",
-            path.display(),
-            e.message().trim_end().replace('\n', " ")
-        )
+        format!("{}:{line}: {}", path.display(), e.message().trim_end().replace('\n', " "))
     })?;
-    let scene =
-        scenes::find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    let scene = scenes::find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
+    let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     if !valid_name(&name) {
         return Err(format!(
             "{}: the file name must use letters, digits, `.`, `_` and `-` only",
@@ -396,26 +377,13 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
     }
     let specs = (scene.params)();
     if !file.presets.contains_key(DEFAULT_PRESET) {
-        return Err(format!(
-            "{}: no [presets.{DEFAULT_PRESET}] (the default preset)",
-            path.display()
-        ));
+        return Err(format!("{}: no [presets.{DEFAULT_PRESET}] (the default preset)", path.display()));
     }
     if file.cases.is_empty() {
-        return Err(format!(
-            "{}: no [[cases]]: a problem needs at least one",
-            path.display()
-        ));
+        return Err(format!("{}: no [[cases]]: a problem needs at least one", path.display()));
     }
     // Preset variables: every preset defines the same names.
-    let first_vars: Vec<&String> = file
-        .presets
-        .values()
-        .next()
-        .unwrap()
-        .get_ref()
-        .keys()
-        .collect();
+    let first_vars: Vec<&String> = file.presets.values().next().unwrap().get_ref().keys().collect();
     for (pname, vars) in &file.presets {
         let names: Vec<&String> = vars.get_ref().keys().collect();
         if names != first_vars {
@@ -438,18 +406,12 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
     }
     out.ok_or_else(|| {
         let known: Vec<_> = file.presets.keys().cloned().collect();
-        format!(
-            "{}: no preset `{preset}`; this problem has: {}",
-            path.display(),
-            known.join(", ")
-        )
+        format!("{}: no preset `{preset}`; this problem has: {}", path.display(), known.join(", "))
     })
 }
 
 fn valid_name(s: &str) -> bool {
-    !s.is_empty()
-        && s.chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'))
+    !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'))
 }
 
 /// A value as written, after substituting preset variables: one value or a list.
@@ -464,11 +426,7 @@ fn to_value(v: &toml::Value) -> Result<Value, String> {
         toml::Value::Integer(i) => Value::Int(*i),
         toml::Value::Float(x) => Value::Float(*x),
         toml::Value::String(s) => Value::Str(s.clone()),
-        other => {
-            return Err(format!(
-                "expected a number, a boolean or a name, found {other}"
-            ))
-        }
+        other => return Err(format!("expected a number, a boolean or a name, found {other}")),
     })
 }
 
@@ -483,20 +441,16 @@ fn resolve_raw(
     let mut val = v.get_ref();
     if let toml::Value::String(s) = val {
         if let Some(var) = s.strip_prefix('$') {
-            val = vars.get(var).map(|x| x.get_ref()).ok_or_else(|| {
-                err(format!(
-                    "preset `{preset}` does not define the variable `{var}`"
-                ))
-            })?;
+            val = vars
+                .get(var)
+                .map(|x| x.get_ref())
+                .ok_or_else(|| err(format!("preset `{preset}` does not define the variable `{var}`")))?;
         }
     }
     match val {
-        toml::Value::Array(a) => a
-            .iter()
-            .map(to_value)
-            .collect::<Result<Vec<_>, _>>()
-            .map(Raw::List)
-            .map_err(err),
+        toml::Value::Array(a) => {
+            a.iter().map(to_value).collect::<Result<Vec<_>, _>>().map(Raw::List).map_err(err)
+        }
         other => to_value(other).map(Raw::One).map_err(err),
     }
 }
@@ -544,13 +498,9 @@ fn select(
         }
     }
     for g in cases {
-        globset::Glob::new(g)
-            .map_err(|e| format!("{}: bad glob `{g}`: {e}", loc.path.display()))?;
+        globset::Glob::new(g).map_err(|e| format!("{}: bad glob `{g}`: {e}", loc.path.display()))?;
     }
-    Ok(Select {
-        cases: cases.to_vec(),
-        where_: w,
-    })
+    Ok(Select { cases: cases.to_vec(), where_: w })
 }
 
 /// Checks that a selection matches at least one case.
@@ -565,41 +515,22 @@ fn nonempty(
     if s.pick(cases).is_empty() {
         let desc = format!(
             "{}{}",
-            if s.cases.is_empty() {
-                String::new()
-            } else {
-                format!("cases {:?} ", s.cases)
-            },
+            if s.cases.is_empty() { String::new() } else { format!("cases {:?} ", s.cases) },
             if s.where_.is_empty() {
                 String::new()
             } else {
                 format!(
                     "where {}",
-                    s.where_
-                        .iter()
-                        .map(|(k, v)| format!("{k} = {v}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
+                    s.where_.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
                 )
             }
         );
         for g in &s.cases {
-            if !cases
-                .iter()
-                .any(|c| glob_matches(g, &c.name).unwrap_or(false))
-            {
-                return Err(loc.err(
-                    span,
-                    what,
-                    format!("no case named `{g}` in preset `{preset}`"),
-                ));
+            if !cases.iter().any(|c| glob_matches(g, &c.name).unwrap_or(false)) {
+                return Err(loc.err(span, what, format!("no case named `{g}` in preset `{preset}`")));
             }
         }
-        return Err(loc.err(
-            span,
-            what,
-            format!("{desc} selects no case in preset `{preset}`"),
-        ));
+        return Err(loc.err(span, what, format!("{desc} selects no case in preset `{preset}`")));
     }
     Ok(())
 }
@@ -617,11 +548,7 @@ fn check_metric(
         Err(loc.err(
             span,
             what,
-            format!(
-                "scene `{}` has no metric `{m}`; its metrics: {}",
-                scene.name,
-                scene.metrics.join(", ")
-            ),
+            format!("scene `{}` has no metric `{m}`; its metrics: {}", scene.name, scene.metrics.join(", ")),
         ))
     }
 }
@@ -644,9 +571,7 @@ fn expand(
                 let x = check_param(loc, v.span(), scene, specs, k, &x)?;
                 base.0.insert(k.clone(), x);
             }
-            Raw::List(_) => {
-                return Err(loc.err(v.span(), k, "a list is a grid: put it under [cases.grid]"))
-            }
+            Raw::List(_) => return Err(loc.err(v.span(), k, "a list is a grid: put it under [cases.grid]")),
         }
     }
     let mut cases: Vec<Case> = Vec::new();
@@ -663,9 +588,7 @@ fn expand(
                     fixed.0.insert(k.clone(), x.clone());
                     set_keys.push((k.clone(), vec![x]));
                 }
-                Raw::List(_) => {
-                    return Err(loc.err(v.span(), k, "a list belongs under [cases.grid]"))
-                }
+                Raw::List(_) => return Err(loc.err(v.span(), k, "a list belongs under [cases.grid]")),
             }
         }
         for (k, v) in &g.grid {
@@ -724,11 +647,7 @@ fn expand(
                 continue; // the same simulation under another name: run it once
             }
             case_lines.insert(cname.clone(), loc.line(gspan.start));
-            cases.push(Case {
-                name: cname,
-                scene: scene.name.to_string(),
-                params: p,
-            });
+            cases.push(Case { name: cname, scene: scene.name.to_string(), params: p });
         }
     }
 
@@ -740,18 +659,10 @@ fn expand(
         let f = f.get_ref();
         let key = format!("figures.{}", f.id);
         if !valid_name(&f.id) {
-            return Err(loc.err(
-                span,
-                &key,
-                "an id may use letters, digits, `.`, `_` and `-` only",
-            ));
+            return Err(loc.err(span, &key, "an id may use letters, digits, `.`, `_` and `-` only"));
         }
         if let Some(l) = ids.insert(f.id.clone(), loc.line(span.start)) {
-            return Err(loc.err(
-                span,
-                &key,
-                format!("a figure or table on line {l} has the same id"),
-            ));
+            return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
         }
         let select = sel(&f.cases, &f.where_)?;
         nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
@@ -764,22 +675,11 @@ fn expand(
             check_metric(loc, span.clone(), &key, scene, m)?;
         }
         let need = |what: &str, v: &Option<String>| {
-            v.clone().ok_or_else(|| {
-                loc.err(
-                    span.clone(),
-                    &key,
-                    format!("kind `{}` needs `{what}`", f.kind),
-                )
-            })
+            v.clone().ok_or_else(|| loc.err(span.clone(), &key, format!("kind `{}` needs `{what}`", f.kind)))
         };
         let kind = match f.kind.as_str() {
-            "timeseries" => FigureKind::Timeseries {
-                y: need("y", &f.y)?,
-                exact: f.exact.clone(),
-            },
-            "particles" => FigureKind::Particles {
-                field: need("field", &f.field)?,
-            },
+            "timeseries" => FigureKind::Timeseries { y: need("y", &f.y)?, exact: f.exact.clone() },
+            "particles" => FigureKind::Particles { field: need("field", &f.field)? },
             "trade" => {
                 need("metric", &f.metric)?;
                 let x = need("x", &f.x)?;
@@ -796,18 +696,14 @@ fn expand(
                 }
                 FigureKind::Stability {
                     x,
-                    max: f.max.ok_or_else(|| {
-                        loc.err(span.clone(), &key, "kind `stability` needs `max`")
-                    })?,
+                    max: f.max.ok_or_else(|| loc.err(span.clone(), &key, "kind `stability` needs `max`"))?,
                 }
             }
             other => {
                 return Err(loc.err(
                     span,
                     &key,
-                    format!(
-                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability"
-                    ),
+                    format!("unknown kind `{other}`; kinds: timeseries, particles, trade, stability"),
                 ))
             }
         };
@@ -815,32 +711,14 @@ fn expand(
             return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
         }
         if f.converges && f.label.is_empty() {
-            return Err(loc.err(
-                span,
-                &key,
-                "`converges` needs `label` (the resolution last)",
-            ));
+            return Err(loc.err(span, &key, "`converges` needs `label` (the resolution last)"));
         }
         let lower_than = match (&f.lower, &f.higher) {
             (Some(a), Some(b)) => {
                 let a = sel(&a.cases, &a.where_)?;
                 let b = sel(&b.cases, &b.where_)?;
-                nonempty(
-                    loc,
-                    span.clone(),
-                    &format!("{key}.lower"),
-                    &a,
-                    &cases,
-                    preset,
-                )?;
-                nonempty(
-                    loc,
-                    span.clone(),
-                    &format!("{key}.higher"),
-                    &b,
-                    &cases,
-                    preset,
-                )?;
+                nonempty(loc, span.clone(), &format!("{key}.lower"), &a, &cases, preset)?;
+                nonempty(loc, span.clone(), &format!("{key}.higher"), &b, &cases, preset)?;
                 Some((a, b))
             }
             (None, None) => None,
@@ -867,11 +745,7 @@ fn expand(
         let t = t.get_ref();
         let key = format!("tables.{}", t.id);
         if let Some(l) = ids.insert(t.id.clone(), loc.line(span.start)) {
-            return Err(loc.err(
-                span,
-                &key,
-                format!("a figure or table on line {l} has the same id"),
-            ));
+            return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
         }
         let select = sel(&t.cases, &t.where_)?;
         nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
@@ -901,10 +775,7 @@ fn expand(
         if b.max.is_none() && b.min.is_none() {
             return Err(loc.err(span, &key, "a bound needs `max` or `min`"));
         }
-        let presets = b
-            .presets
-            .clone()
-            .unwrap_or_else(|| vec![DEFAULT_PRESET.to_string()]);
+        let presets = b.presets.clone().unwrap_or_else(|| vec![DEFAULT_PRESET.to_string()]);
         for p in &presets {
             if !file.presets.contains_key(p) {
                 return Err(loc.err(span, &key, format!("no preset `{p}`")));
@@ -955,24 +826,19 @@ fn case_name(
             let mut rest = t;
             while let Some(i) = rest.find('{') {
                 out.push_str(&rest[..i]);
-                let j = rest[i..]
-                    .find('}')
-                    .ok_or_else(|| format!("unclosed `{{` in name template `{t}`"))?;
+                let j = rest[i..].find('}').ok_or_else(|| format!("unclosed `{{` in name template `{t}`"))?;
                 let key = &rest[i + 1..i + j];
                 let v =
-                    p.0.get(key)
-                        .ok_or_else(|| format!("name template `{t}` names no parameter `{key}`"))?;
+                    p.0.get(key).ok_or_else(|| format!("name template `{t}` names no parameter `{key}`"))?;
                 out.push_str(&show(v));
                 rest = &rest[i + j + 1..];
             }
             out.push_str(rest);
             Ok(out)
         }
-        None => Ok(set_keys
-            .iter()
-            .map(|(k, _)| format!("{k}-{}", show(&p.0[k])))
-            .collect::<Vec<_>>()
-            .join("_")),
+        None => {
+            Ok(set_keys.iter().map(|(k, _)| format!("{k}-{}", show(&p.0[k]))).collect::<Vec<_>>().join("_"))
+        }
     }
 }
 
@@ -1039,18 +905,13 @@ max = 1.0
         assert!(e.contains("nx") && e.contains("integer"), "{e}");
         let e = p(&GOOD.replace("\"sun-*\"", "\"nope\"")).unwrap_err();
         assert!(e.contains("nope") && e.contains("x.toml:1"), "{e}");
-        let e = p(&GOOD.replace(
-            "metric = \"l1_velocity_final\"\nlabel",
-            "metric = \"l2\"\nlabel",
-        ))
-        .unwrap_err();
+        let e =
+            p(&GOOD.replace("metric = \"l1_velocity_final\"\nlabel", "metric = \"l2\"\nlabel")).unwrap_err();
         assert!(e.contains("l2"), "{e}");
         let e = p(&GOOD.replace("taylor_green", "nope")).unwrap_err();
         assert!(e.contains("x.toml:3:") && e.contains("nope"), "{e}");
-        let dup = GOOD.replace(
-            "[[figures]]",
-            "[[cases]]\nname = \"sun-nx12\"\nparams = { re = 5 }\n[[figures]]",
-        );
+        let dup =
+            GOOD.replace("[[figures]]", "[[cases]]\nname = \"sun-nx12\"\nparams = { re = 5 }\n[[figures]]");
         let e = p(&dup).unwrap_err();
         assert!(e.contains("sun-nx12") && e.contains("two cases"), "{e}");
     }

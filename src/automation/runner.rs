@@ -57,17 +57,9 @@ pub struct Report {
 }
 
 /// The cases of `problems` that must run, with the reason, and how many are done.
-pub fn plan(
-    output: &Path,
-    problems: &[Problem],
-    opts: &Options,
-) -> Result<(Vec<Task>, usize), String> {
+pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<Task>, usize), String> {
     let matcher = match &opts.matching {
-        Some(g) => Some(
-            globset::Glob::new(g)
-                .map_err(|e| format!("--match `{g}`: {e}"))?
-                .compile_matcher(),
-        ),
+        Some(g) => Some(globset::Glob::new(g).map_err(|e| format!("--match `{g}`: {e}"))?.compile_matcher()),
         None => None,
     };
     let mut tasks = Vec::new();
@@ -89,11 +81,7 @@ pub fn plan(
                 State::Missing(Some(change)) => format!("stale: {change}"),
                 State::Missing(None) => "missing".to_string(),
             };
-            tasks.push(Task {
-                problem: p.name.clone(),
-                entry: e,
-                reason,
-            });
+            tasks.push(Task { problem: p.name.clone(), entry: e, reason });
         }
     }
     Ok((tasks, done))
@@ -101,9 +89,7 @@ pub fn plan(
 
 /// Cores available to this process.
 pub fn cores() -> usize {
-    std::thread::available_parallelism()
-        .map(|n| n.get())
-        .unwrap_or(1)
+    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
 }
 
 /// Concurrent cases and rayon threads per case for `tasks` cases: jobs x threads <= cores.
@@ -136,13 +122,7 @@ pub fn execute(tasks: Vec<Task>, opts: &Options) -> Result<Report, String> {
     );
     total.set_prefix("all");
     if !tasks.is_empty() {
-        say(
-            &mp,
-            format!(
-                "running {} case(s): {jobs} at a time, {threads} thread(s) each",
-                tasks.len()
-            ),
-        );
+        say(&mp, format!("running {} case(s): {jobs} at a time, {threads} thread(s) each", tasks.len()));
     }
     let queue = Arc::new(Mutex::new(VecDeque::from(tasks)));
     let report = Arc::new(Mutex::new(Report::default()));
@@ -171,10 +151,7 @@ pub fn execute(tasks: Vec<Task>, opts: &Options) -> Result<Report, String> {
                     }
                     Outcome::Failed(why) => {
                         let log = task.entry.dir.join("run.log");
-                        say(
-                            mp,
-                            format!("FAILED  {name}: {why} (log: {})", log.display()),
-                        );
+                        say(mp, format!("FAILED  {name}: {why} (log: {})", log.display()));
                         r.failures.push((name, log, why));
                     }
                 }
@@ -221,10 +198,7 @@ fn run_one(
             Ok(Try::Taken(l)) => break l,
             Ok(Try::Held(pid)) => {
                 if !waited {
-                    say(
-                        mp,
-                        format!("wait    {name} (another runner, pid {pid}, holds it)"),
-                    );
+                    say(mp, format!("wait    {name} (another runner, pid {pid}, holds it)"));
                     waited = true;
                 }
                 if INTERRUPTED.load(Ordering::SeqCst) {
@@ -244,11 +218,7 @@ fn run_one(
     }
     say(mp, format!("run     {name} ({})", task.reason));
     let log_path = e.dir.join("run.log");
-    let log = match std::fs::OpenOptions::new()
-        .create(true)
-        .append(true)
-        .open(&log_path)
-    {
+    let log = match std::fs::OpenOptions::new().create(true).append(true).open(&log_path) {
         Ok(f) => f,
         Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
     };
@@ -285,8 +255,7 @@ fn run_one(
     };
     let bar = mp.add(ProgressBar::new(1000));
     bar.set_style(
-        ProgressStyle::with_template("{prefix:>12} [{elapsed_precise}] {bar:30} {msg}")
-            .expect("template"),
+        ProgressStyle::with_template("{prefix:>12} [{elapsed_precise}] {bar:30} {msg}").expect("template"),
     );
     bar.set_prefix(short(&e.case.name, 12));
     let mut signalled = false;
@@ -298,16 +267,11 @@ fn run_one(
         }
         if INTERRUPTED.load(Ordering::SeqCst) && !signalled {
             // The terminal sends SIGINT to the child too; make sure it gets one.
-            let _ = Command::new("kill")
-                .args(["-INT", &child.id().to_string()])
-                .status();
+            let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
             signalled = true;
         }
         if let Ok(s) = std::fs::read_to_string(&progress) {
-            let v: Vec<f64> = s
-                .split_whitespace()
-                .filter_map(|x| x.parse().ok())
-                .collect();
+            let v: Vec<f64> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
             if v.len() >= 2 && v[1] > 0.0 {
                 bar.set_position((v[0] / v[1] * 1000.0) as u64);
                 bar.set_message(format!("{}  t = {:.3}/{}", e.case.name, v[0], v[1]));
@@ -326,10 +290,7 @@ fn run_one(
     match e.state() {
         State::Done(s) => Outcome::Done(
             secs,
-            serde_json::to_value(s)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default(),
+            serde_json::to_value(s).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
         ),
         State::Failed(r) => Outcome::Failed(format!("{r} (exit status {code})")),
         State::Missing(_) => Outcome::Failed(format!("no result (exit status {code})")),
@@ -340,14 +301,7 @@ fn short(s: &str, n: usize) -> String {
     if s.chars().count() <= n {
         s.to_string()
     } else {
-        let tail: String = s
-            .chars()
-            .rev()
-            .take(n - 1)
-            .collect::<Vec<_>>()
-            .into_iter()
-            .rev()
-            .collect();
+        let tail: String = s.chars().rev().take(n - 1).collect::<Vec<_>>().into_iter().rev().collect();
         format!("…{tail}")
     }
 }

@@ -24,14 +24,9 @@ fn runs<'a>(output: &Path, p: &'a Problem, s: &Select) -> Vec<Run<'a>> {
         .into_iter()
         .map(|c| {
             let entry = Entry::new(output, p, c);
-            let summary = entry
-                .summary()
-                .filter(|s| matches!(s.status, Status::Completed | Status::Diverged));
-            Run {
-                case: c,
-                entry,
-                summary,
-            }
+            let summary =
+                entry.summary().filter(|s| matches!(s.status, Status::Completed | Status::Diverged));
+            Run { case: c, entry, summary }
         })
         .collect()
 }
@@ -42,16 +37,7 @@ fn label(case: &Case, keys: &[String]) -> String {
         return case.name.clone();
     }
     keys.iter()
-        .map(|k| {
-            format!(
-                "{k} = {}",
-                case.params
-                    .0
-                    .get(k)
-                    .map(|v| v.to_string())
-                    .unwrap_or_default()
-            )
-        })
+        .map(|k| format!("{k} = {}", case.params.0.get(k).map(|v| v.to_string()).unwrap_or_default()))
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -59,13 +45,7 @@ fn label(case: &Case, keys: &[String]) -> String {
 /// Values of the `keys` parameters joined by `/` (a curve group).
 fn group(case: &Case, keys: &[String]) -> String {
     keys.iter()
-        .map(|k| {
-            case.params
-                .0
-                .get(k)
-                .map(|v| v.to_string())
-                .unwrap_or_default()
-        })
+        .map(|k| case.params.0.get(k).map(|v| v.to_string()).unwrap_or_default())
         .collect::<Vec<_>>()
         .join("/")
 }
@@ -90,10 +70,7 @@ fn fmt(x: f64) -> String {
 fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     let path = dir.join("timeseries.csv");
     let mut rd = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let headers = rd
-        .headers()
-        .map_err(|e| format!("{}: {e}", path.display()))?
-        .clone();
+    let headers = rd.headers().map_err(|e| format!("{}: {e}", path.display()))?.clone();
     let col = |name: &str| {
         headers.iter().position(|h| h == name).ok_or_else(|| {
             format!(
@@ -137,30 +114,18 @@ fn last_snapshot(dir: &Path, field: &str) -> Result<(Vec<f64>, Vec<f64>, Vec<f64
         .lines()
         .filter_map(|l| {
             let f = l.split("file=\"").nth(1)?.split('"').next()?;
-            let t: f64 = l
-                .split("timestep=\"")
-                .nth(1)?
-                .split('"')
-                .next()?
-                .parse()
-                .ok()?;
+            let t: f64 = l.split("timestep=\"").nth(1)?.split('"').next()?.parse().ok()?;
             Some((t, f.to_string()))
         })
         .last()
         .ok_or_else(|| format!("{}: no snapshot listed", pvd.display()))?;
     let path = dir.join(&file);
     let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-    let nums = |s: &str| -> Vec<f64> {
-        s.split_whitespace()
-            .filter_map(|x| x.parse().ok())
-            .collect()
-    };
+    let nums = |s: &str| -> Vec<f64> { s.split_whitespace().filter_map(|x| x.parse().ok()).collect() };
     let values = data_array(&xml, 0, &format!("Name=\"{field}\""))
         .map(nums)
         .ok_or_else(|| format!("{}: no point array `{field}`", path.display()))?;
-    let pts_at = xml
-        .find("<Points>")
-        .ok_or_else(|| format!("{}: no <Points>", path.display()))?;
+    let pts_at = xml.find("<Points>").ok_or_else(|| format!("{}: no <Points>", path.display()))?;
     let pts = data_array(&xml, pts_at, "DataArray")
         .map(nums)
         .ok_or_else(|| format!("{}: unreadable <Points>", path.display()))?;
@@ -195,11 +160,7 @@ pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Secti
 }
 
 fn missing_note(rs: &[Run]) -> String {
-    let m: Vec<_> = rs
-        .iter()
-        .filter(|r| r.summary.is_none())
-        .map(|r| r.case.name.as_str())
-        .collect();
+    let m: Vec<_> = rs.iter().filter(|r| r.summary.is_none()).map(|r| r.case.name.as_str()).collect();
     if m.is_empty() {
         String::new()
     } else {
@@ -229,10 +190,8 @@ fn ours(f: &Figure, rs: &[Run]) -> String {
     let mut text = format!("`{m}`: {}.", parts.drain(..).collect::<Vec<_>>().join("; "));
     if f.converges {
         let key = f.label.last().expect("validated");
-        let mut pts: Vec<(f64, Option<f64>)> = rs
-            .iter()
-            .map(|r| (param_f64(r.case, key), metric(r, m)))
-            .collect();
+        let mut pts: Vec<(f64, Option<f64>)> =
+            rs.iter().map(|r| (param_f64(r.case, key), metric(r, m))).collect();
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let vals: Vec<f64> = pts.iter().filter_map(|x| x.1).collect();
         if vals.len() < pts.len() || vals.len() < 2 {
@@ -249,11 +208,7 @@ fn ours(f: &Figure, rs: &[Run]) -> String {
     if let Some((lo, hi)) = &f.lower_than {
         // Within the figure's cases.
         let mean = |s: &Select| {
-            let v: Vec<f64> = rs
-                .iter()
-                .filter(|r| s.matches(r.case))
-                .filter_map(|r| metric(r, m))
-                .collect();
+            let v: Vec<f64> = rs.iter().filter(|r| s.matches(r.case)).filter_map(|r| metric(r, m)).collect();
             (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
         };
         match (mean(lo), mean(hi)) {
@@ -289,36 +244,19 @@ fn figure(
         paper: f.paper.clone(),
         ours,
     };
-    let caption = if f.caption.is_empty() {
-        f.title.clone()
-    } else {
-        f.caption.clone()
-    };
+    let caption = if f.caption.is_empty() { f.title.clone() } else { f.caption.clone() };
     match &f.kind {
         FigureKind::Timeseries { y, exact } => {
             let mut series = Vec::new();
-            for r in rs
-                .iter()
-                .filter(|r| r.entry.dir.join("timeseries.csv").exists())
-            {
+            for r in rs.iter().filter(|r| r.entry.dir.join("timeseries.csv").exists()) {
                 let (t, v) = timeseries(&r.entry.dir, y)?;
                 if series.is_empty() {
                     if let Some(ex) = exact {
                         let (t, v) = timeseries(&r.entry.dir, ex)?;
-                        series.push(Series {
-                            label: "exact".into(),
-                            x: t,
-                            y: v,
-                            style: SeriesStyle::Dashed,
-                        });
+                        series.push(Series { label: "exact".into(), x: t, y: v, style: SeriesStyle::Dashed });
                     }
                 }
-                series.push(Series {
-                    label: label(r.case, &f.label),
-                    x: t,
-                    y: v,
-                    style: SeriesStyle::Line,
-                });
+                series.push(Series { label: label(r.case, &f.label), x: t, y: v, style: SeriesStyle::Line });
             }
             report::line_figure(
                 &report::LineFigure {
@@ -350,11 +288,8 @@ fn figure(
                 return Ok(vec![fig_item(&f.id, &caption, missing_note(&rs))]);
             };
             let (x, y, v, t) = last_snapshot(&r.entry.dir, field)?;
-            let (lo, hi) = v
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
-                    (a.min(x), b.max(x))
-                });
+            let (lo, hi) =
+                v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
             report::particle_figure(
                 &report::ScatterField {
                     title: format!("{} (t = {t:.2} s)", f.title),
@@ -404,10 +339,7 @@ fn trade(
         })
         .collect();
     let mut items = Vec::new();
-    for (suffix, what, idx) in [
-        ("wall", "wall time (s)", 0),
-        ("steps", "particle-steps (-)", 1),
-    ] {
+    for (suffix, what, idx) in [("wall", "wall time (s)", 0), ("steps", "particle-steps (-)", 1)] {
         let id = format!("{}_{suffix}", f.id);
         let points = done
             .iter()
@@ -432,20 +364,11 @@ fn trade(
             &figures.join(&id),
         )?;
         let front = report::pareto_front(
-            &done
-                .iter()
-                .map(|d| (if idx == 0 { d.2 } else { d.3 }, d.1))
-                .collect::<Vec<_>>(),
+            &done.iter().map(|d| (if idx == 0 { d.2 } else { d.3 }, d.1)).collect::<Vec<_>>(),
         );
         let names: Vec<String> = front
             .iter()
-            .map(|&i| {
-                format!(
-                    "{} {res}={}",
-                    group(done[i].0.case, &f.label),
-                    done[i].0.case.params.0[res]
-                )
-            })
+            .map(|&i| format!("{} {res}={}", group(done[i].0.case, &f.label), done[i].0.case.params.0[res]))
             .collect();
         items.push(Item::Figure {
             path: format!("figures/{id}.png"),
@@ -453,11 +376,7 @@ fn trade(
             paper: f.paper.clone(),
             ours: format!(
                 "Pareto front ({what}): {}.{}",
-                if names.is_empty() {
-                    "none".into()
-                } else {
-                    names.join("; ")
-                },
+                if names.is_empty() { "none".into() } else { names.join("; ") },
                 missing_note(rs)
             ),
         });
@@ -476,84 +395,53 @@ fn trade(
         let e: Vec<f64> = ds.iter().map(|d| d.1).collect();
         let orders = report::observed_order(&h, &e);
         for (i, d) in ds.iter().enumerate() {
-            let k = done
-                .iter()
-                .position(|x| std::ptr::eq(x.0, d.0))
-                .unwrap_or(usize::MAX);
+            let k = done.iter().position(|x| std::ptr::eq(x.0, d.0)).unwrap_or(usize::MAX);
             rows.push(vec![
                 g.clone(),
                 d.0.case.params.0[res].to_string(),
-                d.0.summary
-                    .as_ref()
-                    .map(|s| s.particles.to_string())
-                    .unwrap_or_default(),
+                d.0.summary.as_ref().map(|s| s.particles.to_string()).unwrap_or_default(),
                 format!("{:.2}", d.2),
                 fmt(d.3),
                 fmt(d.1),
                 if i == 0 {
                     "-".into()
                 } else {
-                    orders[i - 1]
-                        .map(|o| format!("{o:.2}"))
-                        .unwrap_or_else(|| "n/a".into())
+                    orders[i - 1].map(|o| format!("{o:.2}")).unwrap_or_else(|| "n/a".into())
                 },
-                if front_w.contains(&k) {
-                    "yes".into()
-                } else {
-                    String::new()
-                },
+                if front_w.contains(&k) { "yes".into() } else { String::new() },
             ]);
         }
         let os: Vec<f64> = orders.iter().flatten().copied().collect();
         if os.len() >= 2 {
             let sign_change = os.windows(2).any(|w| w[0].signum() != w[1].signum());
-            let spread = os
-                .windows(2)
-                .any(|w| (w[0] - w[1]).abs() > 0.5 * w[0].abs().max(w[1].abs()));
+            let spread = os.windows(2).any(|w| (w[0] - w[1]).abs() > 0.5 * w[0].abs().max(w[1].abs()));
             if sign_change || spread {
                 notes.push(format!(
                     "{g}: orders {} {}: not in the asymptotic range.",
-                    os.iter()
-                        .map(|o| format!("{o:.2}"))
-                        .collect::<Vec<_>>()
-                        .join(", "),
-                    if sign_change {
-                        "change sign"
-                    } else {
-                        "differ by more than 50%"
-                    }
+                    os.iter().map(|o| format!("{o:.2}")).collect::<Vec<_>>().join(", "),
+                    if sign_change { "change sign" } else { "differ by more than 50%" }
                 ));
             }
         } else if os.len() == 1 {
-            notes.push(format!(
-                "{g}: one order ({:.2}) only: the asymptotic range cannot be judged.",
-                os[0]
-            ));
+            notes.push(format!("{g}: one order ({:.2}) only: the asymptotic range cannot be judged.", os[0]));
         }
     }
     report::write_table(
         &report::Table {
             title: format!("{}: {m}, cost and observed order along {res}", f.title),
-            headers: [
-                "scheme",
-                res,
-                "particles",
-                "wall (s)",
-                "particle-steps",
-                m,
-                "order",
-                "Pareto (wall)",
-            ]
-            .iter()
-            .map(|s| s.to_string())
-            .collect(),
+            headers: ["scheme", res, "particles", "wall (s)", "particle-steps", m, "order", "Pareto (wall)"]
+                .iter()
+                .map(|s| s.to_string())
+                .collect(),
             rows,
         },
         &tables.join(&f.id),
     )?;
     items.push(Item::Table {
         md_path: format!("tables/{}.md", f.id),
-        caption: format!("{caption}: error, cost and observed order of convergence (order between consecutive {res})."),
+        caption: format!(
+            "{caption}: error, cost and observed order of convergence (order between consecutive {res})."
+        ),
     });
     if !notes.is_empty() {
         items.push(Item::Text(notes.join(" ")));
@@ -567,16 +455,10 @@ fn outcome(r: &Run, m: &str, max: f64) -> (Outcome, String) {
         None => (Outcome::Missing, "no result".into()),
         Some(s) if s.status == Status::Diverged => (
             Outcome::Diverged,
-            format!(
-                "diverged at t = {:.3}: {}",
-                s.final_time,
-                s.reason.clone().unwrap_or_default()
-            ),
+            format!("diverged at t = {:.3}: {}", s.final_time, s.reason.clone().unwrap_or_default()),
         ),
         Some(s) => match s.metrics.get(m) {
-            Some(v) if v.is_finite() && *v <= max => {
-                (Outcome::Stable, format!("{m} = {}", fmt(*v)))
-            }
+            Some(v) if v.is_finite() && *v <= max => (Outcome::Stable, format!("{m} = {}", fmt(*v))),
             Some(v) => (Outcome::Inaccurate, format!("{m} = {} > {max}", fmt(*v))),
             None => (Outcome::Missing, format!("no `{m}`")),
         },
@@ -610,10 +492,7 @@ fn stability(
     let mut rows = Vec::new();
     let mut counts: BTreeMap<&str, usize> = BTreeMap::new();
     for r in rs {
-        let ix = xs
-            .iter()
-            .position(|a| a.1 == r.case.params.0[x].to_string())
-            .expect("listed");
+        let ix = xs.iter().position(|a| a.1 == r.case.params.0[x].to_string()).expect("listed");
         let g = group(r.case, &f.label);
         let iy = ys.iter().position(|a| *a == g).expect("listed");
         let (o, why) = outcome(r, m, max);
@@ -626,12 +505,7 @@ fn stability(
             })
             .or_default() += 1;
         cells.push((ix, iy, o, None));
-        rows.push(vec![
-            g,
-            xs[ix].1.clone(),
-            format!("{o:?}").to_lowercase(),
-            why,
-        ]);
+        rows.push(vec![g, xs[ix].1.clone(), format!("{o:?}").to_lowercase(), why]);
     }
     report::outcome_map(
         &report::OutcomeMap {
@@ -647,12 +521,7 @@ fn stability(
     report::write_table(
         &report::Table {
             title: format!("{}: outcome per case (inaccurate: {m} > {max})", f.title),
-            headers: vec![
-                f.label.join("/"),
-                x.into(),
-                "outcome".into(),
-                "detail".into(),
-            ],
+            headers: vec![f.label.join("/"), x.into(), "outcome".into(), "detail".into()],
             rows,
         },
         &tables.join(&f.id),
@@ -662,12 +531,7 @@ fn stability(
             path: format!("figures/{}.png", f.id),
             caption: caption.to_string(),
             paper: f.paper.clone(),
-            ours: counts
-                .iter()
-                .map(|(k, v)| format!("{v} {k}"))
-                .collect::<Vec<_>>()
-                .join(", ")
-                + ".",
+            ours: counts.iter().map(|(k, v)| format!("{v} {k}")).collect::<Vec<_>>().join(", ") + ".",
         },
         Item::Table {
             md_path: format!("tables/{}.md", f.id),
@@ -694,34 +558,14 @@ fn metrics_table(p: &Problem, t: &Table, output: &Path, tables: &Path) -> Result
                     .map(|s| format!("{:?}", s.status).to_lowercase())
                     .unwrap_or_else(|| "missing".into()),
             );
-            row.extend(
-                t.metrics
-                    .iter()
-                    .map(|m| metric(r, m).map(fmt).unwrap_or_else(|| "-".into())),
-            );
-            row.push(
-                r.summary
-                    .as_ref()
-                    .map(|s| format!("{:.2}", s.wall_seconds))
-                    .unwrap_or_default(),
-            );
+            row.extend(t.metrics.iter().map(|m| metric(r, m).map(fmt).unwrap_or_else(|| "-".into())));
+            row.push(r.summary.as_ref().map(|s| format!("{:.2}", s.wall_seconds)).unwrap_or_default());
             row
         })
         .collect();
-    report::write_table(
-        &report::Table {
-            title: t.title.clone(),
-            headers,
-            rows,
-        },
-        &tables.join(&t.id),
-    )?;
+    report::write_table(&report::Table { title: t.title.clone(), headers, rows }, &tables.join(&t.id))?;
     Ok(Item::Table {
         md_path: format!("tables/{}.md", t.id),
-        caption: if t.caption.is_empty() {
-            t.title.clone()
-        } else {
-            t.caption.clone()
-        },
+        caption: if t.caption.is_empty() { t.title.clone() } else { t.caption.clone() },
     })
 }

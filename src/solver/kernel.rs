@@ -200,11 +200,7 @@ mod tests {
                     let x = (i as f64 + 0.25) * dx;
                     let y = (j as f64 + 0.25) * dx;
                     let z = (l as f64 + 0.25) * dx;
-                    let r = if dim == 2 {
-                        (x * x + y * y).sqrt()
-                    } else {
-                        (x * x + y * y + z * z).sqrt()
-                    };
+                    let r = if dim == 2 { (x * x + y * y).sqrt() } else { (x * x + y * y + z * z).sqrt() };
                     s += k.w(r, h);
                 }
             }

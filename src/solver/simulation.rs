@@ -151,8 +151,16 @@ impl<const D: usize> Simulation<D> {
         }
         state.scheme = scheme;
         let passes = FluidPasses::new();
-        let mut sim =
-            Self { domain, kernel, time_settings, state, cells, neighbours, passes, times: PhaseTimes::default() };
+        let mut sim = Self {
+            domain,
+            kernel,
+            time_settings,
+            state,
+            cells,
+            neighbours,
+            passes,
+            times: PhaseTimes::default(),
+        };
         sim.state.u_max = sim.max_speed();
         // Initial accelerations for the first half kick; the pressure is the initial one.
         if sim.state.scheme.density == DensityModel::Summation {
@@ -236,8 +244,14 @@ impl<const D: usize> Simulation<D> {
         let st = &mut self.state;
         self.passes.accelerations(&st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt_nominal);
         let clock = lap(clock, &mut self.times.accelerations);
-        st.ipst_iterations =
-            self.passes.ipst(&st.fluid, &self.neighbours, &self.kernel, &st.scheme, &mut st.rates, dt_nominal);
+        st.ipst_iterations = self.passes.ipst(
+            &st.fluid,
+            &self.neighbours,
+            &self.kernel,
+            &st.scheme,
+            &mut st.rates,
+            dt_nominal,
+        );
         lap(clock, &mut self.times.ipst);
     }
 
@@ -257,7 +271,13 @@ impl<const D: usize> Simulation<D> {
             integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
-        Self::rebuild(&self.domain, &self.kernel, &mut self.cells, &mut self.neighbours, &mut self.state.fluid);
+        Self::rebuild(
+            &self.domain,
+            &self.kernel,
+            &mut self.cells,
+            &mut self.neighbours,
+            &mut self.state.fluid,
+        );
         let mut clock = lap(clock, &mut self.times.neighbours);
         {
             let st = &mut self.state;
@@ -265,7 +285,13 @@ impl<const D: usize> Simulation<D> {
                 FluidPasses::summation_density(&mut st.fluid, &self.neighbours);
                 clock = lap(clock, &mut self.times.density);
             }
-            self.passes.update_density_and_pressure(&mut st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt);
+            self.passes.update_density_and_pressure(
+                &mut st.fluid,
+                &self.neighbours,
+                &st.scheme,
+                &mut st.rates,
+                dt,
+            );
         }
         lap(clock, &mut self.times.pressure);
         self.evaluate_accelerations(dt_nominal);

@@ -48,9 +48,7 @@ impl Axis {
         let (lo, hi) = values
             .into_iter()
             .filter(|v| v.is_finite() && (!log || *v > 0.0))
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
-                (a.min(v), b.max(v))
-            });
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| (a.min(v), b.max(v)));
         if log {
             let (lo, hi) = if lo > hi { (0.1, 10.0) } else { (lo, hi) };
             let (a, b) = (lo.log10(), hi.log10());
@@ -114,17 +112,12 @@ impl Ranged for Axis {
 
     fn map(&self, v: &f64, limit: (i32, i32)) -> i32 {
         let f = self.fraction(*v);
-        let f = if f.is_finite() {
-            f.clamp(-10.0, 10.0)
-        } else {
-            0.0
-        };
+        let f = if f.is_finite() { f.clamp(-10.0, 10.0) } else { 0.0 };
         limit.0 + ((limit.1 - limit.0) as f64 * f).round() as i32
     }
 
     fn key_points<H: KeyPointHint>(&self, hint: H) -> Vec<f64> {
-        let light =
-            hint.weight().allow_light_points() && hint.max_num_points() > hint.bold_points();
+        let light = hint.weight().allow_light_points() && hint.max_num_points() > hint.bold_points();
         match self {
             Axis::Linear(lo, hi) => RangedCoordf64::from(*lo..*hi).key_points(hint),
             Axis::Log(lo, hi) => log_ticks(*lo, *hi, hint.bold_points().max(2), light)
@@ -149,10 +142,7 @@ fn log_ticks(lo: f64, hi: f64, max: usize, light: bool) -> Option<Vec<f64>> {
     let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
     let inside = |v: &f64| *v >= lo * (1.0 - 1e-9) && *v <= hi * (1.0 + 1e-9);
     let multiples = |ms: &[f64]| -> Vec<f64> {
-        (a..=b)
-            .flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k)))
-            .filter(inside)
-            .collect()
+        (a..=b).flat_map(|k| ms.iter().map(move |m| m * 10f64.powi(k))).filter(inside).collect()
     };
     let decades = multiples(&[1.0]);
     if decades.len() >= 2 {
@@ -176,11 +166,7 @@ pub(crate) fn fmt_num(v: f64) -> String {
     if (1e-3..1e5).contains(&a) {
         let decimals = (4 - a.log10().floor() as i32).clamp(0, 8) as usize;
         let s = format!("{v:.decimals$}");
-        let s = if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        };
+        let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s };
         return if s == "-0" { "0".into() } else { s };
     }
     let s = format!("{v:.3e}");
@@ -228,9 +214,7 @@ pub(crate) fn save<F: Render>(fig: &F, stem: &Path) -> Result<(), String> {
 fn draw_on<F: Render, DB: DrawingBackend>(fig: &F, backend: DB) -> Result<(), String> {
     let root = backend.into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let area = root
-        .titled(fig.title(), text(TITLE_SIZE))
-        .map_err(|e| e.to_string())?;
+    let area = root.titled(fig.title(), text(TITLE_SIZE)).map_err(|e| e.to_string())?;
     fig.render(&area)?;
     root.present().map_err(|e| e.to_string())
 }
@@ -342,12 +326,7 @@ pub(crate) fn densify(x: &Axis, y: &Axis, pts: &[(f64, f64)]) -> Vec<(f64, f64)>
     let mut out = Vec::with_capacity(pts.len() * 8);
     for w in pts.windows(2) {
         let (a, b) = (w[0], w[1]);
-        let (ax, ay, bx, by) = (
-            x.fraction(a.0),
-            y.fraction(a.1),
-            x.fraction(b.0),
-            y.fraction(b.1),
-        );
+        let (ax, ay, bx, by) = (x.fraction(a.0), y.fraction(a.1), x.fraction(b.0), y.fraction(b.1));
         for k in 0..8 {
             let t = k as f64 / 8.0;
             out.push((inv(x, ax + (bx - ax) * t), inv(y, ay + (by - ay) * t)));
@@ -398,10 +377,7 @@ mod tests {
 
     #[test]
     fn log_ticks_are_decades_or_125() {
-        assert_eq!(
-            log_ticks(1e-4, 2e-1, 8, false).unwrap(),
-            vec![1e-4, 1e-3, 1e-2, 1e-1]
-        );
+        assert_eq!(log_ticks(1e-4, 2e-1, 8, false).unwrap(), vec![1e-4, 1e-3, 1e-2, 1e-1]);
         let thin = log_ticks(1e-12, 1.0, 5, false).unwrap();
         assert!(thin.len() <= 5 && thin.len() >= 3, "{thin:?}");
         let narrow = log_ticks(0.15, 0.9, 8, false).unwrap();

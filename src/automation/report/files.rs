@@ -14,8 +14,9 @@ pub(crate) fn with_suffix(stem: &Path, suffix: &str) -> PathBuf {
 /// Creates the directory that will hold `path`.
 pub(crate) fn create_parent(path: &Path) -> Result<(), String> {
     match path.parent() {
-        Some(dir) if !dir.as_os_str().is_empty() => fs::create_dir_all(dir)
-            .map_err(|e| format!("{}: cannot create directory: {e}", dir.display())),
+        Some(dir) if !dir.as_os_str().is_empty() => {
+            fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create directory: {e}", dir.display()))
+        }
         _ => Ok(()),
     }
 }

@@ -22,12 +22,7 @@ pub(crate) struct Glyph<C> {
 impl<C> Glyph<C> {
     /// Marker of shape `kind` and radius `size` pixels centred at `at`.
     pub(crate) fn marker(kind: usize, at: C, size: i32, style: ShapeStyle) -> Self {
-        Glyph {
-            at,
-            line: None,
-            mark: Some((kind, size, style)),
-            dx: 0,
-        }
+        Glyph { at, line: None, mark: Some((kind, size, style)), dx: 0 }
     }
 
     /// Legend sample starting at `at`: an optional (optionally dashed) line, with an
@@ -37,12 +32,7 @@ impl<C> Glyph<C> {
         line: Option<(ShapeStyle, bool)>,
         mark: Option<(usize, i32, ShapeStyle)>,
     ) -> Self {
-        Glyph {
-            at,
-            line,
-            mark,
-            dx: SAMPLE / 2,
-        }
+        Glyph { at, line, mark, dx: SAMPLE / 2 }
     }
 }
 
@@ -65,11 +55,7 @@ impl<C, DB: DrawingBackend> Drawable<DB> for Glyph<C> {
             return Ok(());
         };
         if let Some((style, dashed)) = self.line {
-            let pieces: &[(i32, i32)] = if dashed {
-                &[(0, 6), (9, 15), (18, 24)]
-            } else {
-                &[(0, SAMPLE)]
-            };
+            let pieces: &[(i32, i32)] = if dashed { &[(0, 6), (9, 15), (18, 24)] } else { &[(0, SAMPLE)] };
             for &(a, b) in pieces {
                 backend.draw_line((x + a, y), (x + b, y), &style)?;
             }
@@ -99,29 +85,9 @@ fn draw_marker<DB: DrawingBackend>(
     };
     match kind % 5 {
         0 => backend.draw_circle((x, y), s.max(1) as u32, style, style.filled),
-        1 => polygon(
-            backend,
-            vec![
-                (x, y - s - 1),
-                (x + s + 1, y + s - 1),
-                (x - s - 1, y + s - 1),
-            ],
-        ),
-        2 => backend.draw_rect(
-            (x - s + 1, y - s + 1),
-            (x + s - 1, y + s - 1),
-            style,
-            style.filled,
-        ),
-        3 => polygon(
-            backend,
-            vec![
-                (x, y - s - 1),
-                (x + s + 1, y),
-                (x, y + s + 1),
-                (x - s - 1, y),
-            ],
-        ),
+        1 => polygon(backend, vec![(x, y - s - 1), (x + s + 1, y + s - 1), (x - s - 1, y + s - 1)]),
+        2 => backend.draw_rect((x - s + 1, y - s + 1), (x + s - 1, y + s - 1), style, style.filled),
+        3 => polygon(backend, vec![(x, y - s - 1), (x + s + 1, y), (x, y + s + 1), (x - s - 1, y)]),
         _ => {
             let thick = style.stroke_width(2);
             backend.draw_line((x - s, y - s), (x + s, y + s), &thick)?;

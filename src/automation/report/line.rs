@@ -120,8 +120,7 @@ impl Render for LineFigure {
                 if k == 0 {
                     let sample_line = with_line.then_some((line, dashed));
                     let sample_mark = with_marks.then_some((0, 4, color.filled()));
-                    anno.label(s.label.clone())
-                        .legend(move |p| Glyph::sample(p, sample_line, sample_mark));
+                    anno.label(s.label.clone()).legend(move |p| Glyph::sample(p, sample_line, sample_mark));
                 }
                 if with_marks && with_line {
                     chart
@@ -130,11 +129,7 @@ impl Render for LineFigure {
                 }
             }
         }
-        let pts: Vec<(f64, f64)> = runs
-            .iter()
-            .flatten()
-            .flat_map(|r| densify(&x, &y, r))
-            .collect();
+        let pts: Vec<(f64, f64)> = runs.iter().flatten().flat_map(|r| densify(&x, &y, r)).collect();
         let labelled = runs.iter().filter(|r| !r.is_empty()).count();
         if labelled > 0 {
             canvas::legend(&mut chart, labelled, &pts)?;
@@ -193,18 +188,9 @@ mod tests {
         let svg = check_figure(
             &stem,
             (900, 600),
-            &[
-                "L2 error vs h &lt;TVF&gt;",
-                "EDAC",
-                "CTVF",
-                "second order",
-                "h [m]",
-            ],
+            &["L2 error vs h &lt;TVF&gt;", "EDAC", "CTVF", "second order", "h [m]"],
         );
-        assert!(
-            svg.contains("1e-3") || svg.contains("1e-4"),
-            "log tick labels"
-        );
+        assert!(svg.contains("1e-3") || svg.contains("1e-4"), "log tick labels");
     }
 
     #[test]
@@ -229,30 +215,15 @@ mod tests {
                     label: "simulated".into(),
                     x: t.clone(),
                     y: t.iter()
-                        .map(|t| {
-                            if *t > 3.0 && *t < 3.3 {
-                                f64::NAN
-                            } else {
-                                (-0.82 * t).exp()
-                            }
-                        })
+                        .map(|t| if *t > 3.0 && *t < 3.3 { f64::NAN } else { (-0.82 * t).exp() })
                         .collect(),
                     style: SeriesStyle::Line,
                 },
-                Series {
-                    label: "nothing".into(),
-                    x: vec![],
-                    y: vec![],
-                    style: SeriesStyle::Line,
-                },
+                Series { label: "nothing".into(), x: vec![], y: vec![], style: SeriesStyle::Line },
             ],
         };
         line_figure(&fig, &stem).unwrap();
-        check_figure(
-            &stem,
-            (900, 600),
-            &["Kinetic energy decay", "exact", "simulated"],
-        );
+        check_figure(&stem, (900, 600), &["Kinetic energy decay", "exact", "simulated"]);
         fig.series.clear();
         line_figure(&fig, &stem).unwrap();
     }

@@ -66,12 +66,7 @@ pub fn write_manuscript(m: &Manuscript, path: &Path) -> Result<(), String> {
         push_text(&mut out, &s.text);
         for item in &s.items {
             match item {
-                Item::Figure {
-                    path: img,
-                    caption,
-                    paper,
-                    ours,
-                } => {
+                Item::Figure { path: img, caption, paper, ours } => {
                     figures += 1;
                     let alt = caption.replace(['[', ']', '\n'], " ");
                     let _ = write!(out, "![{alt}]({})\n\n", img.replace(' ', "%20"));
@@ -81,13 +76,9 @@ pub fn write_manuscript(m: &Manuscript, path: &Path) -> Result<(), String> {
                 Item::Table { md_path, caption } => {
                     tables += 1;
                     let file = base.join(md_path);
-                    let md = std::fs::read_to_string(&file)
-                        .map_err(|e| format!("{}: {e}", file.display()))?;
-                    let _ = write!(
-                        out,
-                        "**Table {tables}.** {caption}\n\n{}\n\n",
-                        md.trim_end()
-                    );
+                    let md =
+                        std::fs::read_to_string(&file).map_err(|e| format!("{}: {e}", file.display()))?;
+                    let _ = write!(out, "**Table {tables}.** {caption}\n\n{}\n\n", md.trim_end());
                 }
                 Item::Text(t) => push_text(&mut out, t),
             }
@@ -115,10 +106,7 @@ mod tests {
         let t = Table {
             title: "orders".into(),
             headers: vec!["scheme".into(), "order".into()],
-            rows: vec![
-                vec!["EDAC".into(), "1.98".into()],
-                vec!["TVF".into(), "1.91".into()],
-            ],
+            rows: vec![vec!["EDAC".into(), "1.98".into()], vec!["TVF".into(), "1.91".into()]],
         };
         write_table(&t, &dir.path().join("paper/tables/orders")).unwrap();
         let m = Manuscript {
@@ -134,10 +122,7 @@ mod tests {
                         paper: "all schemes follow the exact decay.".into(),
                         ours: "max deviation 1.2 % (CTVF).".into(),
                     },
-                    Item::Table {
-                        md_path: "tables/orders.md".into(),
-                        caption: "Observed orders".into(),
-                    },
+                    Item::Table { md_path: "tables/orders.md".into(), caption: "Observed orders".into() },
                     Item::Text("CTVF is the most accurate.".into()),
                     Item::Figure {
                         path: "figures/tg_pareto.svg".into(),
@@ -160,20 +145,15 @@ mod tests {
         assert!(md.contains("**Table 1.** Observed orders"));
         assert!(md.contains("| scheme | order |\n|---|---|\n| EDAC | 1.98 |\n| TVF | 1.91 |"));
         assert!(md.contains("**Figure 2.** Cost vs accuracy"));
-        let leftovers: Vec<_> = std::fs::read_dir(dir.path().join("paper"))
-            .unwrap()
-            .map(|e| e.unwrap().file_name())
-            .collect();
+        let leftovers: Vec<_> =
+            std::fs::read_dir(dir.path().join("paper")).unwrap().map(|e| e.unwrap().file_name()).collect();
         assert_eq!(leftovers.len(), 2, "{leftovers:?}"); // manuscript.md and tables/
 
         let missing = Manuscript {
             sections: vec![Section {
                 title: "s".into(),
                 text: String::new(),
-                items: vec![Item::Table {
-                    md_path: "nope.md".into(),
-                    caption: "c".into(),
-                }],
+                items: vec![Item::Table { md_path: "nope.md".into(), caption: "c".into() }],
             }],
             ..m
         };

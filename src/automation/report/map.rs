@@ -23,12 +23,7 @@ pub enum Outcome {
 }
 
 impl Outcome {
-    const ALL: [Outcome; 4] = [
-        Outcome::Stable,
-        Outcome::Inaccurate,
-        Outcome::Diverged,
-        Outcome::Missing,
-    ];
+    const ALL: [Outcome; 4] = [Outcome::Stable, Outcome::Inaccurate, Outcome::Diverged, Outcome::Missing];
 
     fn color(self) -> RGBColor {
         match self {
@@ -80,10 +75,7 @@ impl Render for OutcomeMap {
 
     fn size(&self) -> (u32, u32) {
         let (nx, ny) = (self.x_ticks.len() as u32, self.y_ticks.len() as u32);
-        (
-            (330 + KEY_PANEL + 100 * nx).clamp(700, 2400),
-            (180 + 56 * ny).clamp(360, 1600),
-        )
+        ((330 + KEY_PANEL + 100 * nx).clamp(700, 2400), (180 + 56 * ny).clamp(360, 1600))
     }
 
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
@@ -93,54 +85,29 @@ impl Render for OutcomeMap {
         let row = |j: usize| (ny - 1 - j) as f64;
         let (w, _) = area.dim_in_pixel();
         let (grid, key) = area.split_horizontally(w.saturating_sub(KEY_PANEL));
-        let mut chart = canvas::chart(
-            &grid,
-            Axis::Category(self.x_ticks.clone()),
-            Axis::Category(rows),
-        )?;
+        let mut chart = canvas::chart(&grid, Axis::Category(self.x_ticks.clone()), Axis::Category(rows))?;
         canvas::mesh(&mut chart, &self.x_label, &self.y_label, false)?;
 
         let mut outcome = vec![Outcome::Missing; nx * ny];
         for &(i, j, o, _) in self.cells.iter().filter(|c| c.0 < nx && c.1 < ny) {
             outcome[j * nx + i] = o;
         }
-        let cell = |i: usize, j: usize| {
-            [
-                (i as f64 - 0.5, row(j) - 0.5),
-                (i as f64 + 0.5, row(j) + 0.5),
-            ]
-        };
+        let cell = |i: usize, j: usize| [(i as f64 - 0.5, row(j) - 0.5), (i as f64 + 0.5, row(j) + 0.5)];
         let all = (0..ny).flat_map(|j| (0..nx).map(move |i| (i, j)));
-        let fill = |(i, j): (usize, usize)| {
-            Rectangle::new(cell(i, j), outcome[j * nx + i].color().filled())
-        };
-        chart
-            .draw_series(all.clone().map(fill))
-            .map_err(|e| e.to_string())?;
+        let fill = |(i, j): (usize, usize)| Rectangle::new(cell(i, j), outcome[j * nx + i].color().filled());
+        chart.draw_series(all.clone().map(fill)).map_err(|e| e.to_string())?;
         let border = |(i, j): (usize, usize)| Rectangle::new(cell(i, j), WHITE.stroke_width(3));
-        chart
-            .draw_series(all.map(border))
-            .map_err(|e| e.to_string())?;
+        chart.draw_series(all.map(border)).map_err(|e| e.to_string())?;
 
         let centre = Pos::new(HPos::Center, VPos::Center);
-        let labels = self
-            .cells
-            .iter()
-            .filter(|c| c.0 < nx && c.1 < ny)
-            .filter_map(|(i, j, o, t)| {
-                let ink: &'static RGBColor = if *o == Outcome::Diverged {
-                    &WHITE
-                } else {
-                    &BLACK
-                };
-                let style = canvas::text(TICK_SIZE - 2).pos(centre).color(ink);
-                t.as_ref()
-                    .map(|t| Text::new(t.clone(), (*i as f64, row(*j)), style))
-            });
+        let labels = self.cells.iter().filter(|c| c.0 < nx && c.1 < ny).filter_map(|(i, j, o, t)| {
+            let ink: &'static RGBColor = if *o == Outcome::Diverged { &WHITE } else { &BLACK };
+            let style = canvas::text(TICK_SIZE - 2).pos(centre).color(ink);
+            t.as_ref().map(|t| Text::new(t.clone(), (*i as f64, row(*j)), style))
+        });
         chart.draw_series(labels).map_err(|e| e.to_string())?;
 
-        let entries: Vec<(&str, RGBColor)> =
-            Outcome::ALL.iter().map(|o| (o.name(), o.color())).collect();
+        let entries: Vec<(&str, RGBColor)> = Outcome::ALL.iter().map(|o| (o.name(), o.color())).collect();
         canvas::key(&key, &entries, MARGIN as i32 + 10)
     }
 }

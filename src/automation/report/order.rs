@@ -11,8 +11,7 @@ pub fn observed_order(h: &[f64], err: &[f64]) -> Vec<Option<f64>> {
     (1..n)
         .map(|i| {
             let (h0, h1, e0, e1) = (h[i - 1], h[i], err[i - 1], err[i]);
-            (ok(h0) && ok(h1) && ok(e0) && ok(e1) && h0 != h1)
-                .then(|| (e0 / e1).ln() / (h0 / h1).ln())
+            (ok(h0) && ok(h1) && ok(e0) && ok(e1) && h0 != h1).then(|| (e0 / e1).ln() / (h0 / h1).ln())
         })
         .collect()
 }

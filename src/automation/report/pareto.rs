@@ -31,18 +31,12 @@ pub struct ParetoFigure {
 /// (then y). A point is dominated if another is no worse in both coordinates and better
 /// in one; points with a NaN coordinate are never on the front; exact duplicates both are.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
-    let dominates =
-        |a: (f64, f64), b: (f64, f64)| a.0 <= b.0 && a.1 <= b.1 && (a.0 < b.0 || a.1 < b.1);
+    let dominates = |a: (f64, f64), b: (f64, f64)| a.0 <= b.0 && a.1 <= b.1 && (a.0 < b.0 || a.1 < b.1);
     let mut front: Vec<usize> = (0..points.len())
         .filter(|&i| !points[i].0.is_nan() && !points[i].1.is_nan())
         .filter(|&i| !points.iter().any(|&q| dominates(q, points[i])))
         .collect();
-    front.sort_by(|&a, &b| {
-        points[a]
-            .0
-            .total_cmp(&points[b].0)
-            .then(points[a].1.total_cmp(&points[b].1))
-    });
+    front.sort_by(|&a, &b| points[a].0.total_cmp(&points[b].0).then(points[a].1.total_cmp(&points[b].1)));
     front
 }
 
@@ -65,11 +59,8 @@ impl Render for ParetoFigure {
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let x = Axis::fit(self.points.iter().map(|p| p.2), self.log_x);
         let y = Axis::fit(self.points.iter().map(|p| p.3), self.log_y);
-        let shown: Vec<&(String, String, f64, f64)> = self
-            .points
-            .iter()
-            .filter(|p| x.accepts(p.2) && y.accepts(p.3))
-            .collect();
+        let shown: Vec<&(String, String, f64, f64)> =
+            self.points.iter().filter(|p| x.accepts(p.2) && y.accepts(p.3)).collect();
         let mut groups: Vec<&str> = Vec::new();
         for p in &self.points {
             if !groups.contains(&p.0.as_str()) {
@@ -99,11 +90,7 @@ impl Render for ParetoFigure {
                     + Circle::new((12, 0), 7, REFERENCE.stroke_width(1))
             });
         chart
-            .draw_series(
-                front
-                    .iter()
-                    .map(|&c| Circle::new(c, 10, REFERENCE.stroke_width(2))),
-            )
+            .draw_series(front.iter().map(|&c| Circle::new(c, 10, REFERENCE.stroke_width(2))))
             .map_err(|e| e.to_string())?;
 
         let beside = canvas::text(canvas::TICK_SIZE - 3).pos(Pos::new(HPos::Left, VPos::Bottom));
@@ -111,16 +98,13 @@ impl Render for ParetoFigure {
             let color = palette(g);
             let mine: Vec<_> = shown.iter().filter(|p| p.0 == *name).collect();
             chart
-                .draw_series(
-                    mine.iter()
-                        .map(|p| Glyph::marker(g, (p.2, p.3), 6, color.filled())),
-                )
+                .draw_series(mine.iter().map(|p| Glyph::marker(g, (p.2, p.3), 6, color.filled())))
                 .map_err(|e| e.to_string())?
                 .label(*name)
                 .legend(move |p| Glyph::sample(p, None, Some((g, 6, color.filled()))));
-            let labels = mine.iter().map(|p| {
-                EmptyElement::at((p.2, p.3)) + Text::new(p.1.clone(), (8, -6), beside.clone())
-            });
+            let labels = mine
+                .iter()
+                .map(|p| EmptyElement::at((p.2, p.3)) + Text::new(p.1.clone(), (8, -6), beside.clone()));
             chart.draw_series(labels).map_err(|e| e.to_string())?;
         }
         // Keep the legend off the points and the front line between them.
@@ -160,12 +144,7 @@ mod tests {
         let mut points = Vec::new();
         for (s, c, e) in [("EDAC", 1.0, 1.0), ("TVF", 1.6, 0.5), ("CTVF", 2.0, 0.3)] {
             for nx in [25.0, 50.0, 100.0] {
-                points.push((
-                    s.to_string(),
-                    format!("nx={nx}"),
-                    c * nx * nx * 1e-4,
-                    e / (nx * nx),
-                ));
+                points.push((s.to_string(), format!("nx={nx}"), c * nx * nx * 1e-4, e / (nx * nx)));
             }
         }
         points.push(("TVF".into(), "nx=0".into(), 0.0, 1e-3));
@@ -181,14 +160,7 @@ mod tests {
         check_figure(
             &stem,
             (900, 650),
-            &[
-                "Cost vs accuracy",
-                "EDAC",
-                "TVF",
-                "CTVF",
-                "Pareto front",
-                "nx=50",
-            ],
+            &["Cost vs accuracy", "EDAC", "TVF", "CTVF", "Pareto front", "nx=50"],
         );
     }
 }

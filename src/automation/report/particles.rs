@@ -42,9 +42,7 @@ impl ScatterField {
             self.value
                 .iter()
                 .filter(|v| v.is_finite())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
-                    (a.min(v), b.max(v))
-                })
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| (a.min(v), b.max(v)))
         });
         if !(lo.is_finite() && hi.is_finite()) || lo > hi {
             (0.0, 1.0)
@@ -58,10 +56,7 @@ impl ScatterField {
     /// Axes fitted to the positions; with `aspect_equal`, widened so one data unit has
     /// the same length in pixels on both axes of a `w` x `h` plotting area.
     fn axes(&self, w: f64, h: f64) -> (Axis, Axis) {
-        let (x, y) = (
-            Axis::fit(self.x.iter().copied(), false),
-            Axis::fit(self.y.iter().copied(), false),
-        );
+        let (x, y) = (Axis::fit(self.x.iter().copied(), false), Axis::fit(self.y.iter().copied(), false));
         if !self.aspect_equal {
             return (x, y);
         }
@@ -87,9 +82,7 @@ impl Render for ScatterField {
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
         let (w, h) = area.dim_in_pixel();
         let (main, bar) = area.split_horizontally(w.saturating_sub(BAR_PANEL));
-        let pw = (w - BAR_PANEL)
-            .saturating_sub(2 * MARGIN + Y_LABEL_AREA)
-            .max(1) as f64;
+        let pw = (w - BAR_PANEL).saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1) as f64;
         let ph = h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1) as f64;
         let (x, y) = self.axes(pw, ph);
         let (lo, hi) = self.value_range();
@@ -98,15 +91,11 @@ impl Render for ScatterField {
 
         let n = self.x.len().min(self.y.len()).min(self.value.len());
         // Dots about a third of the mean spacing, as if the particles filled the plot.
-        let r = ((pw * ph / n.max(1) as f64).sqrt() * 0.35)
-            .clamp(1.0, 6.0)
-            .round() as i32;
-        let dots = (0..n)
-            .filter(|&i| self.x[i].is_finite() && self.y[i].is_finite())
-            .map(|i| {
-                let c = viridis((self.value[i] - lo) / (hi - lo));
-                Circle::new((self.x[i], self.y[i]), r, c.filled())
-            });
+        let r = ((pw * ph / n.max(1) as f64).sqrt() * 0.35).clamp(1.0, 6.0).round() as i32;
+        let dots = (0..n).filter(|&i| self.x[i].is_finite() && self.y[i].is_finite()).map(|i| {
+            let c = viridis((self.value[i] - lo) / (hi - lo));
+            Circle::new((self.x[i], self.y[i]), r, c.filled())
+        });
         chart.draw_series(dots).map_err(|e| e.to_string())?;
         colour_bar(&bar, lo, hi, &self.value_label)
     }
@@ -178,11 +167,7 @@ mod tests {
             aspect_equal: true,
         };
         particle_figure(&f, &stem).unwrap();
-        check_figure(
-            &stem,
-            (900, 720),
-            &["Taylor-Green pressure, t = 2 s", "p [Pa]"],
-        );
+        check_figure(&stem, (900, 720), &["Taylor-Green pressure, t = 2 s", "p [Pa]"]);
         let (x, y) = f.axes(600.0, 300.0);
         let (xr, yr) = (x.range(), y.range());
         let ratio = ((xr.end - xr.start) / 600.0) / ((yr.end - yr.start) / 300.0);
@@ -202,13 +187,7 @@ mod tests {
             aspect_equal: false,
         };
         particle_figure(&f, &dir.path().join("c")).unwrap();
-        let empty = ScatterField {
-            x: vec![],
-            y: vec![],
-            value: vec![],
-            range: None,
-            ..f
-        };
+        let empty = ScatterField { x: vec![], y: vec![], value: vec![], range: None, ..f };
         particle_figure(&empty, &dir.path().join("e")).unwrap();
         assert_eq!(empty.value_range(), (0.0, 1.0));
     }

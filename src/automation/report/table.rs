@@ -40,25 +40,15 @@ pub fn write_table(t: &Table, stem: &Path) -> Result<(), String> {
     for r in &t.rows {
         w.write_record(padded(r)).map_err(named)?;
     }
-    let bytes = w
-        .into_inner()
-        .map_err(|e| format!("{}: {e}", csv_path.display()))?;
+    let bytes = w.into_inner().map_err(|e| format!("{}: {e}", csv_path.display()))?;
     write_atomic(&csv_path, &bytes)?;
     write_atomic(&md_path, markdown(t, width, padded).as_bytes())
 }
 
 fn markdown(t: &Table, width: usize, padded: impl Fn(&Vec<String>) -> Vec<String>) -> String {
     let cell = |c: &str| c.replace('|', "\\|").replace(['\r', '\n'], " ");
-    let line = |cells: &[String]| {
-        format!(
-            "| {} |\n",
-            cells
-                .iter()
-                .map(|c| cell(c))
-                .collect::<Vec<_>>()
-                .join(" | ")
-        )
-    };
+    let line =
+        |cells: &[String]| format!("| {} |\n", cells.iter().map(|c| cell(c)).collect::<Vec<_>>().join(" | "));
     let mut md = format!("<!-- {} -->\n", t.title.replace("--", "- -"));
     md += &line(&t.headers);
     md += &format!("|{}\n", "---|".repeat(width));
@@ -93,10 +83,8 @@ mod tests {
 
         let mut r = csv::Reader::from_path(dir.path().join("tables/conv.csv")).unwrap();
         assert_eq!(r.headers().unwrap().iter().collect::<Vec<_>>(), t.headers);
-        let rows: Vec<Vec<String>> = r
-            .records()
-            .map(|rec| rec.unwrap().iter().map(String::from).collect())
-            .collect();
+        let rows: Vec<Vec<String>> =
+            r.records().map(|rec| rec.unwrap().iter().map(String::from).collect()).collect();
         assert_eq!(rows.len(), 3);
         assert_eq!(rows[0], t.rows[0]);
         assert_eq!(rows[1], t.rows[1]);
@@ -115,8 +103,7 @@ mod tests {
     fn too_long_row_is_an_error_naming_the_file() {
         let dir = tempfile::tempdir().unwrap();
         let mut t = sample();
-        t.rows
-            .push(vec!["1".into(), "2".into(), "3".into(), "4".into()]);
+        t.rows.push(vec!["1".into(), "2".into(), "3".into(), "4".into()]);
         let e = write_table(&t, &dir.path().join("bad")).unwrap_err();
         assert!(e.contains("bad.csv") && e.contains("row 3"), "{e}");
     }

@@ -134,6 +134,30 @@ impl<const D: usize> CellList<D> {
         for (k, s) in self.sorted.iter_mut().enumerate() {
             *s = k as u32;
         }
+        for c in 0..self.cell_start.len() - 1 {
+            let range = self.cell_start[c] as usize..self.cell_start[c + 1] as usize;
+            self.cell_of[range].iter_mut().for_each(|v| *v = c as u32);
+        }
+    }
+
+    /// The cell point `i` was binned into (by the last [`update`](Self::update), in the
+    /// current order after [`mark_reordered`](Self::mark_reordered)).
+    #[inline(always)]
+    pub fn cell_of(&self, i: usize) -> usize {
+        self.cell_of[i] as usize
+    }
+
+    /// Calls `f(candidates, wraps)` for each of the 3^D cells around cell `cell` (as
+    /// [`for_each_candidate_cell`](Self::for_each_candidate_cell) does for a position).
+    #[inline(always)]
+    pub fn for_each_cell_around<F: FnMut(&[u32], [i8; D])>(&self, cell: usize, f: F) {
+        let mut coords = [0i64; D];
+        let mut rest = cell;
+        for (k, c) in coords.iter_mut().enumerate() {
+            *c = (rest % self.ncells[k]) as i64;
+            rest /= self.ncells[k];
+        }
+        self.visit_cells(coords, f);
     }
 
     /// Calls `f(j, x_ij, r2)` for every point `j` with `|x_i - x_j| < radius`, where
@@ -189,13 +213,24 @@ impl<const D: usize> CellList<D> {
     /// that `q - x_j` is the pair difference) and the periods wrapped per axis.
     #[inline(always)]
     pub fn for_each_candidate_cell<F: FnMut(&[u32], Vector<D>, [i8; D])>(&self, query: &Vector<D>, mut f: F) {
+        let mut coords = [0i64; D];
+        for (k, c) in coords.iter_mut().enumerate() {
+            *c = ((query[k] - self.origin[k]) / self.cell_size[k]).floor() as i64;
+        }
+        self.visit_cells(coords, |candidates, w| f(candidates, query - self.shift(w), w));
+    }
+
+    /// The 3^D cells around integer cell coordinates `coords` (which may lie outside the
+    /// grid), with the periods wrapped to reach each.
+    #[inline(always)]
+    fn visit_cells<F: FnMut(&[u32], [i8; D])>(&self, coords: [i64; D], mut f: F) {
         // Per axis: the (up to three) neighbour cell coordinates and the periods wrapped
         // to reach them.
         let mut cells = [[0usize; 3]; D];
         let mut wraps = [[0i8; 3]; D];
         let mut counts = [0usize; D];
         for k in 0..D {
-            let c = ((query[k] - self.origin[k]) / self.cell_size[k]).floor() as i64;
+            let c = coords[k];
             let n = self.ncells[k] as i64;
             if self.domain.periodic[k] {
                 for o in -1..=1i64 {
@@ -230,7 +265,7 @@ impl<const D: usize> CellList<D> {
             }
             let cell = self.linear(&c);
             let (start, end) = (self.cell_start[cell] as usize, self.cell_start[cell + 1] as usize);
-            f(&self.sorted[start..end], query - self.shift(w), w);
+            f(&self.sorted[start..end], w);
             let mut k = 0;
             loop {
                 if k == D {
@@ -304,9 +339,7 @@ mod tests {
         let clear = |i: usize, v: &[usize]| -> Vec<usize> {
             v.iter()
                 .copied()
-                .filter(|&j| {
-                    (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius
-                })
+                .filter(|&j| (domain.delta(&points[i], &points[j]).norm() - radius).abs() > 1e-12 * radius)
                 .collect()
         };
         for i in 0..points.len() {
@@ -316,10 +349,7 @@ mod tests {
                 "point {i}, radius {radius}, domain {domain:?}"
             );
         }
-        assert!(
-            brute.iter().map(|v| v.len()).sum::<usize>() > points.len(),
-            "test has pairs"
-        );
+        assert!(brute.iter().map(|v| v.len()).sum::<usize>() > points.len(), "test has pairs");
     }
 
     #[test]

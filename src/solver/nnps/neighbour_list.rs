@@ -17,17 +17,20 @@ const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
 
 #[derive(Clone, Debug, Default)]
-struct Chunk<P> {
+struct Chunk<const D: usize, P> {
     start: Vec<u32>,
     entries: Vec<u32>,
     payload: Vec<P>,
+    /// Scratch: the candidates around the current cell, packed, with their image
+    /// positions `x_j + shift`.
+    candidates: Vec<(u32, Vector<D>)>,
 }
 
 /// For every point of a body, its neighbours within the search radius in the same body,
 /// each with a payload `P` computed from the pair at build time.
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList<const D: usize, P = ()> {
-    chunks: Vec<Chunk<P>>,
+    chunks: Vec<Chunk<D, P>>,
     /// Image shift per code: code = sum_k (wraps_k + 1) 3^k.
     shifts: Vec<Vector<D>>,
 }
@@ -38,9 +41,10 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         Self { chunks: Vec::new(), shifts: Vec::new() }
     }
 
-    /// Lists the neighbours of every point of `points` (which `cells` binned) among the
-    /// same points, with `payload(x_ij, r2)` per pair. Panics if the body has 2^26 points
-    /// or more.
+    /// Lists the neighbours of every point of `points` among the same points, with
+    /// `payload(x_ij, r2)` per pair. `cells` must have binned exactly these points (in this
+    /// order: call it after [`CellList::mark_reordered`] if the points were reordered).
+    /// Panics if the body has 2^26 points or more.
     pub fn build(
         &mut self,
         cells: &CellList<D>,
@@ -66,30 +70,43 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
             chunk.start.clear();
             chunk.entries.clear();
             chunk.payload.clear();
+            // Points are visited in cell order, so the candidates of a cell (gathered with
+            // their image positions) serve every point in it.
+            let mut current = usize::MAX;
             for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                let cell = cells.cell_of(i);
+                if cell != current {
+                    current = cell;
+                    chunk.candidates.clear();
+                    cells.for_each_cell_around(cell, |indices, wraps| {
+                        let mut code = 0u32;
+                        for k in (0..D).rev() {
+                            debug_assert!(
+                                (-1..=1).contains(&wraps[k]),
+                                "self-queries wrap by one period at most"
+                            );
+                            code = code * 3 + (wraps[k] + 1) as u32;
+                        }
+                        let shift = shifts[code as usize];
+                        chunk.candidates.extend(
+                            indices.iter().map(|&j| (j | (code << J_BITS), points[j as usize] + shift)),
+                        );
+                    });
+                }
                 let first = chunk.entries.len();
                 chunk.start.push(first as u32);
-                cells.for_each_candidate_cell(&points[i], |candidates, q, wraps| {
-                    let mut code = 0u32;
-                    for k in (0..D).rev() {
-                        debug_assert!(
-                            (-1..=1).contains(&wraps[k]),
-                            "self-queries wrap by one period at most"
-                        );
-                        code = code * 3 + (wraps[k] + 1) as u32;
-                    }
-                    // Append every candidate, advancing the length only for neighbours:
-                    // no branch on the distance test, which is unpredictable.
-                    let mut len = chunk.entries.len();
-                    chunk.entries.resize(len + candidates.len(), 0);
-                    for &j in candidates {
-                        chunk.entries[len] = j | (code << J_BITS);
-                        len += ((q - points[j as usize]).norm_squared() < r2max) as usize;
-                    }
-                    chunk.entries.truncate(len);
-                });
-                // The payload of the accepted pairs, in a loop without the distance branch.
+                // Append every candidate, advancing the length only for neighbours: no
+                // branch on the distance test, which is unpredictable.
                 let xi = points[i];
+                chunk.entries.resize(first + chunk.candidates.len(), 0);
+                let mut len = first;
+                for &(e, xj) in &chunk.candidates {
+                    chunk.entries[len] = e;
+                    len += ((xi - xj).norm_squared() < r2max) as usize;
+                }
+                chunk.entries.truncate(len);
+                // The payload of the accepted pairs, in a loop without the distance branch,
+                // from the same difference `for_each` computes.
                 for &e in &chunk.entries[first..] {
                     let xij = (xi - shifts[(e >> J_BITS) as usize]) - points[(e & J_MASK) as usize];
                     chunk.payload.push(payload(xij, xij.norm_squared()));
