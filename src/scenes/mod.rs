@@ -3,6 +3,9 @@
 //! the [`harness`] runs any scene and writes its output. The automation half sees only
 //! [`SCENES`].
 
+pub mod cavity;
+pub mod common;
+pub mod geometry;
 pub mod harness;
 pub mod params;
 pub mod taylor_green;
@@ -64,7 +67,7 @@ pub struct SceneEntry {
 }
 
 /// Every scene.
-pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY];
+pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY, cavity::ENTRY];
 
 /// Looks a scene up by name.
 pub fn find(name: &str) -> Result<&'static SceneEntry, String> {

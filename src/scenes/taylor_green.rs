@@ -14,13 +14,13 @@
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
 use super::params::{Bound, Params, Spec};
+use super::common::{fluid_scheme, scheme_params, write_fluid, FluidConstants};
 use super::{common_params, SceneEntry, SceneRun};
-use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::output::vtu::{write_vtu, Field};
+use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
-use crate::solver::scheme::{Corrections, DensityModel, FluidSettings, Pst, SchemeName};
+use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
@@ -48,46 +48,14 @@ pub const ENTRY: SceneEntry = SceneEntry {
     ],
 };
 
-const SWITCH: &[&str] = &["auto", "on", "off"];
-
 fn params() -> Vec<Spec> {
     let mut v = vec![
         Spec::int("nx", 50, 1, "particles per side"),
         Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
-        Spec::choice("scheme", SchemeName::NAMES, "ctvf", "fluid scheme"),
-        Spec::choice("pst", Pst::NAMES, "sun", "particle shifting for ctvf: Sun 2019, IPST or none"),
-        Spec::choice("kernel", KernelKind::NAMES, "quintic_spline", "smoothing kernel"),
-        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
-        Spec::choice("corrections", &["all", "none"], "all", "the CTVF correction terms, together"),
-        Spec::choice(
-            "corr_continuity",
-            SWITCH,
-            "auto",
-            "the correction of eq. (25); auto follows `corrections`",
-        ),
-        Spec::choice(
-            "corr_pressure",
-            SWITCH,
-            "auto",
-            "the corrections of eq. (26); auto follows `corrections`",
-        ),
-        Spec::choice(
-            "corr_momentum",
-            SWITCH,
-            "auto",
-            "the -u div(u~ - u) term of eq. (19); auto follows `corrections`",
-        ),
         Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx"),
         Spec::int("seed", 1, 0, "seed of the initial perturbation"),
-        Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
-        Spec::float(
-            "ipst_tol",
-            0.02,
-            Bound::Positive,
-            "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
-        ),
-        Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
     ];
+    v.extend(scheme_params("sun"));
     v.extend(common_params(2.0));
     v
 }
@@ -101,14 +69,6 @@ pub fn exact(x: &Vector<2>, t: f64, re: f64) -> (Vector<2>, f64) {
     let u = Vector::<2>::new(-e * cx * sy, e * sx * cy);
     let p = -e * e * ((4.0 * PI * x[0]).cos() + (4.0 * PI * x[1]).cos()) / 4.0;
     (u, p)
-}
-
-fn switch(p: &Params, key: &str, all: bool) -> bool {
-    match p.str(key) {
-        "on" => true,
-        "off" => false,
-        _ => all,
-    }
 }
 
 struct TaylorGreen {
@@ -126,36 +86,19 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
-    let hdx = p.float("hdx");
     let dx = L / nx as f64;
-    let h = hdx * dx;
-    let kind = KernelKind::from_name(p.str("kernel")).expect("checked choice");
-    let kernel = Kernel::new(kind, 2);
-    let scheme_name = SchemeName::from_name(p.str("scheme")).expect("checked choice");
-    let all = p.str("corrections") == "all";
-    let corrections = Corrections {
-        continuity: switch(p, "corr_continuity", all),
-        pressure: switch(p, "corr_pressure", all),
-        momentum: switch(p, "corr_momentum", all),
-    };
-    let settings = FluidSettings {
+    let constants = FluidConstants {
         rho0: RHO0,
         c0: C0,
         u_ref: U,
-        h,
-        w_dx: kernel.w(dx, h),
+        dx,
         nu: Some(U * L / re),
         alpha: None,
-        edac_alpha: p.float("edac_alpha"),
         density: DensityModel::Summation,
-        pst: Pst::from_name(p.str("pst")).expect("checked choice"),
-        corrections,
-        ipst_tol: p.float("ipst_tol"),
-        ipst_max_iter: p.int("ipst_max_iter") as usize,
         gravity: [0.0; 3],
         internal_flow: true,
     };
-    let scheme = scheme_name.fluid_scheme(&settings);
+    let (kernel, h, scheme) = fluid_scheme(p, &constants);
 
     // Lattice at cell centres, optionally perturbed (seeded), initialised from the exact
     // solution at t = 0 at the perturbed positions.
@@ -303,27 +246,16 @@ impl SceneRun for TaylorGreen {
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         let f = self.sim.fluid();
         let t = self.sim.time();
-        let pts: Vec<[f64; 3]> = f.x.iter().map(|x| [x[0], x[1], 0.0]).collect();
-        let vel: Vec<[f64; 3]> = f.u.iter().map(|u| [u[0], u[1], 0.0]).collect();
-        let speed: Vec<f64> = f.u.iter().map(|u| u.norm()).collect();
         let p_exact: Vec<f64> = f.x.iter().map(|x| exact(x, t, self.re).1).collect();
         // The pressure level of a periodic weakly compressible flow drifts freely (only
         // differences act); the deviation from the mean is the field to look at.
         let p_mean = f.p.iter().sum::<f64>() / f.len() as f64;
         let p_dev: Vec<f64> = f.p.iter().map(|p| p - p_mean).collect();
         let name = format!("fluid_{index:05}.vtu");
-        write_vtu(
+        write_fluid(
             &dir.join(&name),
-            &pts,
-            &[
-                Field::Vector("velocity", vel),
-                Field::Scalar("speed", speed),
-                Field::Scalar("pressure", f.p.clone()),
-                Field::Scalar("pressure_deviation", p_dev),
-                Field::Scalar("pressure_exact", p_exact),
-                Field::Scalar("density", f.rho.clone()),
-                Field::Int("id", f.id.iter().map(|&i| i as i64).collect()),
-            ],
+            f,
+            vec![Field::Scalar("pressure_deviation", p_dev), Field::Scalar("pressure_exact", p_exact)],
         )?;
         Ok(vec![("fluid".into(), name)])
     }

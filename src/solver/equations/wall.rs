@@ -53,10 +53,17 @@ pub struct Ghost<const D: usize> {
 /// Eqs. (46)-(52) for one wall particle with prescribed velocity `u_p`, acceleration
 /// `a_w` and unit normal `n` (into the fluid), from its fluid sums; `g` is gravity.
 /// A wall particle with no fluid neighbour gets zero pressure and the mirror of zero.
+///
+/// In eqs. (48)-(49) only the wall's normal velocity matters (the tangential part of the
+/// mirrored velocity is the fluid's): it is `u_p . n` for a wall that moves in space, and
+/// zero for a wall whose particles stay put while its surface slides (`sliding`, a lid).
+/// With the lid's velocity there, the lid's corner particles, whose normals are diagonal,
+/// would recede from the fluid and suck the corner particle through the wall.
 #[inline(always)]
 pub fn ghost<const D: usize>(
     s: &WallSums<D>,
     u_p: Vector<D>,
+    sliding: bool,
     a_w: Vector<D>,
     n: Vector<D>,
     g: Vector<D>,
@@ -68,12 +75,13 @@ pub fn ghost<const D: usize>(
     } else {
         (0.0, Vector::zeros(), Vector::zeros())
     };
+    let u_n = if sliding { 0.0 } else { u_p.dot(&n) };
     Ghost {
         p,
         // eq. (48): the normal component mirrored about the wall's, the tangential kept
-        u_slip: n * (2.0 * (u_p - u_f).dot(&n)) + u_f,
+        u_slip: n * (2.0 * (u_n - u_f.dot(&n))) + u_f,
         // eq. (49)
-        u_hat_slip: n * (2.0 * (u_p - u_hat_f).dot(&n)) + u_hat_f,
+        u_hat_slip: n * (2.0 * (u_n - u_hat_f.dot(&n))) + u_hat_f,
         // eq. (50): the whole velocity mirrored about the wall's
         u_noslip: u_p * 2.0 - u_f,
     }
@@ -90,14 +98,18 @@ mod tests {
         let u = Vector::<2>::new(0.3, -0.2);
         s.add(2.0, Vector::<2>::new(0.0, -0.1), 5.0, 1000.0, u, u);
         let n = Vector::<2>::new(0.0, 1.0);
-        let g = ghost(&s, Vector::zeros(), Vector::zeros(), n, Vector::<2>::new(0.0, -9.81));
+        let g = ghost(&s, Vector::zeros(), false, Vector::zeros(), n, Vector::<2>::new(0.0, -9.81));
         assert!((g.p - (5.0 + 1000.0 * 9.81 * 0.1)).abs() < 1e-9, "p_w = p_f + rho g d: {}", g.p);
         // Free slip: tangential kept, normal reversed (the fluid cannot go through).
         assert!((g.u_slip - Vector::<2>::new(0.3, 0.2)).norm() < 1e-12);
         // No slip: the mean of fluid and ghost velocity is the wall's (zero).
         assert!((g.u_noslip + u).norm() < 1e-12);
         // A moving lid: the no-slip ghost makes the mean equal to the lid speed.
-        let lid = ghost(&s, Vector::<2>::new(1.0, 0.0), Vector::zeros(), -n, Vector::zeros());
+        let lid = ghost(&s, Vector::<2>::new(1.0, 0.0), true, Vector::zeros(), -n, Vector::zeros());
         assert!(((lid.u_noslip + u) * 0.5 - Vector::<2>::new(1.0, 0.0)).norm() < 1e-12);
+        // A sliding lid has no normal velocity, even at a corner with a diagonal normal.
+        let diag = Vector::<2>::new(-1.0, -1.0).normalize();
+        let corner = ghost(&s, Vector::<2>::new(1.0, 0.0), true, Vector::zeros(), diag, Vector::zeros());
+        assert!(((corner.u_slip + u).dot(&diag)).abs() < 1e-12, "no penetration through the corner");
     }
 }

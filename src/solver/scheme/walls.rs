@@ -53,14 +53,15 @@ impl<const D: usize> WallSet<D> {
         let (x, u_wall, normal) = (&wall.x, &wall.u_wall, &wall.normal);
         wall.ghost.resize(
             x.len(),
-            ghost(&WallSums::default(), Vector::zeros(), Vector::zeros(), Vector::zeros(), g),
+            ghost(&WallSums::default(), Vector::zeros(), true, Vector::zeros(), Vector::zeros(), g),
         );
         wall.ghost.par_iter_mut().enumerate().for_each(|(i, out)| {
             let mut s = WallSums::default();
             list.for_each_from(i, x[i], &fluid.x, |j, x_wf, _, &w| {
                 s.add(w, x_wf, fluid.p[j], fluid.rho[j], fluid.u[j], u_hat[j]);
             });
-            *out = ghost(&s, u_wall[i], Vector::zeros(), normal[i], g);
+            // The wall particles do not move: their velocity is the slip of a sliding surface.
+            *out = ghost(&s, u_wall[i], true, Vector::zeros(), normal[i], g);
         });
     }
 }

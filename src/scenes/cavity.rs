@@ -1,0 +1,259 @@
+//! Lid-driven cavity (CTVF paper, sec. 4.2, figs. 13-15): a unit square of fluid in three
+//! layers of wall particles, the lid sliding at U = 1 m/s; rho0 = 1, c0 = 10 U,
+//! nu = U L / Re (the paper prints Re / U: SEED-NOTES), summation density, no artificial
+//! viscosity. Run to steady state: the criterion is the relative change of the kinetic
+//! energy over the last `ke_window` seconds (metric `kinetic_energy_change`).
+//!
+//! Metrics: `ghia_u_rms`, `ghia_u_max` (deviation of u along x = 0.5 from Ghia et al.
+//! (1982), Table I, at their interior points, in units of the lid speed), `ghia_v_rms`,
+//! `ghia_v_max` (v along y = 0.5, Table II), for the Re columns Ghia tabulates (absent
+//! otherwise); `kinetic_energy_change`. Velocities at the probe points are Shepard
+//! interpolations of the fluid particles. Files: `centerline_u.csv` (y, u) and
+//! `centerline_v.csv` (x, v), 101 points each.
+
+use super::common::{fluid_scheme, scheme_params, shepard, write_fluid, write_wall, FluidConstants};
+use super::geometry::{box_walls, lattice};
+use super::params::{Bound, Params, Spec};
+use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::math::Vector;
+use crate::solver::nnps::Domain;
+use crate::solver::particles::{Fluid, FluidInit, Wall};
+use crate::solver::scheme::DensityModel;
+use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const U: f64 = 1.0;
+const L: f64 = 1.0;
+const RHO0: f64 = 1.0;
+const C0: f64 = 10.0 * U;
+const LAYERS: usize = 3;
+const GHIA_U: &str = include_str!("../../reference_data/ghia1982_u_vertical_centerline.csv");
+const GHIA_V: &str = include_str!("../../reference_data/ghia1982_v_horizontal_centerline.csv");
+
+/// The registry entry.
+pub const ENTRY: SceneEntry = SceneEntry {
+    name: "cavity",
+    dim: 2,
+    about: "Lid-driven cavity against Ghia et al. 1982 (CTVF sec. 4.2)",
+    params,
+    build,
+    metrics: &["ghia_u_rms", "ghia_u_max", "ghia_v_rms", "ghia_v_max", "kinetic_energy_change"],
+};
+
+fn params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::int("nx", 50, 4, "fluid particles per side"),
+        Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
+        Spec::float("ke_window", 1.0, Bound::Positive, "window of the steady-state criterion (s)"),
+    ];
+    v.extend(scheme_params("sun"));
+    v.extend(common_params(10.0));
+    v
+}
+
+/// Ghia's centre-line table for `re`: (coordinate, value) pairs, if tabulated.
+fn ghia(table: &str, re: f64) -> Option<Vec<(f64, f64)>> {
+    let mut lines = table.lines();
+    let header: Vec<&str> = lines.next()?.split(',').collect();
+    let col = header.iter().position(|h| h.trim() == format!("Re{}", re.round() as i64))?;
+    if (re - re.round()).abs() > 1e-9 {
+        return None;
+    }
+    Some(
+        lines
+            .filter_map(|l| {
+                let f: Vec<f64> = l.split(',').filter_map(|v| v.trim().parse().ok()).collect();
+                (f.len() == header.len()).then(|| (f[0], f[col]))
+            })
+            .collect(),
+    )
+}
+
+struct Cavity {
+    sim: Simulation<2>,
+    re: f64,
+    ke_window: f64,
+    /// (t, kinetic energy) samples.
+    energy: Vec<(f64, f64)>,
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let nx = p.int("nx") as usize;
+    let re = p.float("re");
+    let dx = L / nx as f64;
+    let constants = FluidConstants {
+        rho0: RHO0,
+        c0: C0,
+        u_ref: U,
+        dx,
+        nu: Some(U * L / re),
+        alpha: None,
+        density: DensityModel::Summation,
+        gravity: [0.0; 3],
+        internal_flow: true,
+    };
+    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {
+        return Err(format!(
+            "scene `cavity`: kernel support {:.3} dx exceeds the {LAYERS} wall layers: lower `hdx` (= {})",
+            kernel.support() * h / dx,
+            p.float("hdx")
+        ));
+    }
+    let x = lattice(0.0, L, 0.0, L, dx);
+    let n = x.len();
+    let init = FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: vec![0.0; n], x };
+    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
+    let walls = box_walls(L, L, dx, LAYERS, true);
+    let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
+    let wall = Wall::new(
+        "wall",
+        walls.iter().map(|w| w.0).collect(),
+        walls.iter().map(|w| lid(&w.0)).collect(),
+        walls.iter().map(|w| w.1).collect(),
+        RHO0 * dx * dx,
+        RHO0,
+        C0,
+    )?;
+    let edge = (LAYERS as f64 + 0.5) * dx;
+    let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
+    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
+    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time, false)
+        .map_err(|e| format!("scene `cavity`: {e}"))?;
+    Ok(Box::new(Cavity { sim, re, ke_window: p.float("ke_window"), energy: Vec::new() }))
+}
+
+impl Cavity {
+    fn kinetic_energy(&self) -> f64 {
+        let f = self.sim.fluid();
+        // In particle-id order: independent of the internal ordering and the threads.
+        let order = f.by_id(&(0..f.len() as u32).collect::<Vec<_>>());
+        order.iter().map(|&k| 0.5 * f.m[k as usize] * f.u[k as usize].norm_squared()).sum()
+    }
+
+    /// u along x = 0.5 at `y`, and v along y = 0.5 at `x`.
+    fn probe(&self, q: Vector<2>, component: usize) -> Option<f64> {
+        let f = self.sim.fluid();
+        shepard(f, &self.sim.kernel, q, |j| f.u[j][component])
+    }
+
+    /// RMS and max deviation from Ghia's interior points.
+    fn ghia_deviation(&self, table: &str, vertical: bool) -> Option<(f64, f64)> {
+        let points = ghia(table, self.re)?;
+        let (mut sum2, mut max, mut n) = (0.0, 0.0f64, 0);
+        for (s, reference) in points.into_iter().filter(|(s, _)| *s > 0.0 && *s < 1.0) {
+            let q = if vertical { Vector::<2>::new(0.5, s) } else { Vector::<2>::new(s, 0.5) };
+            let value = self.probe(q, if vertical { 0 } else { 1 })?;
+            let d = (value - reference).abs() / U;
+            sum2 += d * d;
+            max = max.max(d);
+            n += 1;
+        }
+        (n > 0).then(|| ((sum2 / n as f64).sqrt(), max))
+    }
+
+    fn write_profile(&self, path: &Path, vertical: bool) -> std::io::Result<()> {
+        let mut s = if vertical { String::from("y,u\n") } else { String::from("x,v\n") };
+        for k in 0..=100 {
+            let c = k as f64 / 100.0;
+            let q = if vertical { Vector::<2>::new(0.5, c) } else { Vector::<2>::new(c, 0.5) };
+            if let Some(v) = self.probe(q, if vertical { 0 } else { 1 }) {
+                s.push_str(&format!("{c},{v:e}\n"));
+            }
+        }
+        crate::solver::output::write_atomic(path, s.as_bytes())
+    }
+}
+
+impl SceneRun for Cavity {
+    fn particles(&self) -> usize {
+        self.sim.fluid().len() + self.sim.walls.as_ref().map_or(0, |w| w.wall.len())
+    }
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    fn steps(&self) -> u64 {
+        self.sim.steps()
+    }
+    fn plan(&self) -> String {
+        let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
+        format!(
+            "body `fluid`: {} particles, h = {:.4e}; body `wall`: {w} particles ({LAYERS} layers, lid at U = {U})\n{}",
+            self.sim.fluid().len(),
+            self.sim.fluid().h,
+            self.sim.state.scheme
+        )
+    }
+    fn advance(
+        &mut self,
+        t_stop: f64,
+        t_end: f64,
+        on_step: &mut dyn FnMut(f64, u64) -> bool,
+    ) -> Result<bool, Divergence> {
+        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
+    }
+    fn sample(&mut self) -> Vec<(&'static str, f64)> {
+        let ke = self.kinetic_energy();
+        self.energy.push((self.sim.time(), ke));
+        vec![("t", self.sim.time()), ("kinetic_energy", ke), ("u_max", self.sim.max_speed())]
+    }
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
+        let name = format!("fluid_{index:05}.vtu");
+        write_fluid(&dir.join(&name), self.sim.fluid(), Vec::new())?;
+        let mut files = vec![("fluid".to_string(), name)];
+        if let Some(ws) = &self.sim.walls {
+            let name = format!("wall_{index:05}.vtu");
+            write_wall(&dir.join(&name), &ws.wall)?;
+            files.push(("wall".into(), name));
+        }
+        // The centre-line profiles of the latest state (the case folder is the parent).
+        if let Some(case) = dir.parent() {
+            self.write_profile(&case.join("centerline_u.csv"), true)?;
+            self.write_profile(&case.join("centerline_v.csv"), false)?;
+        }
+        Ok(files)
+    }
+    fn metrics(&self) -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::new();
+        if let Some((rms, max)) = self.ghia_deviation(GHIA_U, true) {
+            m.insert("ghia_u_rms".into(), rms);
+            m.insert("ghia_u_max".into(), max);
+        }
+        if let Some((rms, max)) = self.ghia_deviation(GHIA_V, false) {
+            m.insert("ghia_v_rms".into(), rms);
+            m.insert("ghia_v_max".into(), max);
+        }
+        // Relative change of the kinetic energy over the last window (steady state).
+        let t = self.sim.time();
+        let ke = self.kinetic_energy();
+        let before = self.energy.iter().rev().find(|(s, _)| *s <= t - self.ke_window).or(self.energy.first());
+        if let Some(&(_, ke0)) = before {
+            m.insert("kinetic_energy_change".into(), (ke - ke0).abs() / ke.max(1e-300));
+        }
+        m
+    }
+    fn save_state(&self) -> serde_json::Value {
+        serde_json::json!({ "sim": &self.sim.state, "energy": &self.energy })
+    }
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
+        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.energy = serde_json::from_value(state["energy"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.sim.restore(sim);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ghia_tables_parse() {
+        let u = ghia(GHIA_U, 100.0).unwrap();
+        assert_eq!(u.len(), 17);
+        assert_eq!(u[1], (0.0547, -0.03717));
+        assert_eq!(ghia(GHIA_V, 1000.0).unwrap()[1], (0.0625, 0.27485));
+        assert!(ghia(GHIA_U, 250.0).is_none());
+    }
+}

@@ -1,0 +1,139 @@
+//! What the fluid scenes share: the scheme parameters every fluid scene declares, the
+//! scheme built from them, and the ParaView snapshots of fluid and wall bodies.
+
+use super::params::{Bound, Params, Spec};
+use crate::solver::kernel::{Kernel, KernelKind};
+use crate::solver::math::Vector;
+use crate::solver::output::vtu::{write_vtu, Field};
+use crate::solver::particles::{Fluid, Wall};
+use crate::solver::scheme::{Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName};
+use std::path::Path;
+
+const SWITCH: &[&str] = &["auto", "on", "off"];
+
+/// The scheme parameters of a fluid scene (`pst` defaults to `default_pst`).
+pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
+    vec![
+        Spec::choice("scheme", SchemeName::NAMES, "ctvf", "fluid scheme"),
+        Spec::choice("pst", Pst::NAMES, default_pst, "particle shifting for ctvf: Sun 2019, IPST or none"),
+        Spec::choice("kernel", KernelKind::NAMES, "quintic_spline", "smoothing kernel"),
+        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
+        Spec::choice("corrections", &["all", "none"], "all", "the CTVF correction terms, together"),
+        Spec::choice("corr_continuity", SWITCH, "auto", "the correction of eq. (25); auto follows `corrections`"),
+        Spec::choice("corr_pressure", SWITCH, "auto", "the corrections of eq. (26); auto follows `corrections`"),
+        Spec::choice("corr_momentum", SWITCH, "auto", "the -u div(u~ - u) term of eq. (19); auto follows `corrections`"),
+        Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
+        Spec::float("ipst_tol", 0.02, Bound::Positive, "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)"),
+        Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
+    ]
+}
+
+fn switch(p: &Params, key: &str, all: bool) -> bool {
+    match p.str(key) {
+        "on" => true,
+        "off" => false,
+        _ => all,
+    }
+}
+
+/// The physical constants a scene gives its fluid.
+pub struct FluidConstants {
+    /// Reference density.
+    pub rho0: f64,
+    /// Speed of sound.
+    pub c0: f64,
+    /// Reference velocity.
+    pub u_ref: f64,
+    /// Particle spacing.
+    pub dx: f64,
+    /// Kinematic viscosity.
+    pub nu: Option<f64>,
+    /// Artificial viscosity alpha.
+    pub alpha: Option<f64>,
+    /// Density model.
+    pub density: DensityModel,
+    /// Gravity.
+    pub gravity: [f64; 3],
+    /// No free surface (the pressure level is arbitrary).
+    pub internal_flow: bool,
+}
+
+/// The kernel, smoothing length and scheme the parameters ask for.
+pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme) {
+    let h = p.float("hdx") * c.dx;
+    let kernel = Kernel::new(KernelKind::from_name(p.str("kernel")).expect("checked choice"), 2);
+    let all = p.str("corrections") == "all";
+    let corrections = Corrections {
+        continuity: switch(p, "corr_continuity", all),
+        pressure: switch(p, "corr_pressure", all),
+        momentum: switch(p, "corr_momentum", all),
+    };
+    let settings = FluidSettings {
+        rho0: c.rho0,
+        c0: c.c0,
+        u_ref: c.u_ref,
+        h,
+        w_dx: kernel.w(c.dx, h),
+        nu: c.nu,
+        alpha: c.alpha,
+        edac_alpha: p.float("edac_alpha"),
+        density: c.density,
+        pst: Pst::from_name(p.str("pst")).expect("checked choice"),
+        corrections,
+        ipst_tol: p.float("ipst_tol"),
+        ipst_max_iter: p.int("ipst_max_iter") as usize,
+        gravity: c.gravity,
+        internal_flow: c.internal_flow,
+    };
+    let scheme = SchemeName::from_name(p.str("scheme")).expect("checked choice").fluid_scheme(&settings);
+    (kernel, h, scheme)
+}
+
+fn pad(v: &Vector<2>) -> [f64; 3] {
+    [v[0], v[1], 0.0]
+}
+
+/// Writes a fluid snapshot with velocity, speed, pressure, density, id and `extra` fields.
+pub fn write_fluid(path: &Path, f: &Fluid<2>, extra: Vec<Field>) -> std::io::Result<()> {
+    let mut fields = vec![
+        Field::Vector("velocity", f.u.iter().map(pad).collect()),
+        Field::Scalar("speed", f.u.iter().map(|u| u.norm()).collect()),
+        Field::Scalar("pressure", f.p.clone()),
+        Field::Scalar("density", f.rho.clone()),
+        Field::Int("id", f.id.iter().map(|&i| i as i64).collect()),
+    ];
+    fields.extend(extra);
+    write_vtu(path, &f.x.iter().map(pad).collect::<Vec<_>>(), &fields)
+}
+
+/// Writes a wall snapshot: prescribed velocity, extrapolated pressure and density, normal.
+pub fn write_wall(path: &Path, w: &Wall<2>) -> std::io::Result<()> {
+    write_vtu(
+        path,
+        &w.x.iter().map(pad).collect::<Vec<_>>(),
+        &[
+            Field::Vector("velocity", w.u_wall.iter().map(pad).collect()),
+            Field::Scalar("speed", w.u_wall.iter().map(|u| u.norm()).collect()),
+            Field::Scalar("pressure", w.ghost.iter().map(|g| g.p).collect()),
+            Field::Scalar("density", (0..w.len()).map(|i| w.rho(i)).collect()),
+            Field::Vector("normal", w.normal.iter().map(pad).collect()),
+        ],
+    )
+}
+
+/// Shepard interpolation of `value` (per fluid particle) at `q`: `sum v W / sum W`, by
+/// brute force over the particles (for a handful of probe points at the end of a run).
+pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize) -> f64) -> Option<f64> {
+    let k = kernel.scaled(f.h);
+    let r2max = (kernel.support() * f.h).powi(2);
+    let (mut num, mut den) = (0.0, 0.0);
+    for j in 0..f.len() {
+        let r2 = (q - f.x[j]).norm_squared();
+        if r2 < r2max {
+            let w = k.w(r2.sqrt());
+            num += value(j) * w;
+            den += w;
+        }
+    }
+    (den > 0.0).then(|| num / den)
+}
