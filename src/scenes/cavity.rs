@@ -103,7 +103,13 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     }
     let x = lattice(0.0, L, 0.0, L, dx);
     let n = x.len();
-    let init = FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: vec![0.0; n], x };
+    let init = FluidInit {
+        u: vec![Vector::zeros(); n],
+        m: vec![RHO0 * dx * dx; n],
+        rho: vec![RHO0; n],
+        p: vec![0.0; n],
+        x,
+    };
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
     let walls = box_walls(L, L, dx, LAYERS, true);
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
@@ -142,7 +148,11 @@ impl Cavity {
     fn ghia_deviation(&self, table: &str, vertical: bool) -> Option<(f64, f64)> {
         let points = ghia(table, self.re)?;
         let (mut sum2, mut max, mut n) = (0.0, 0.0f64, 0);
-        for (s, reference) in points.into_iter().filter(|(s, _)| *s > 0.0 && *s < 1.0) {
+        // Interior points only (the end rows are the wall values). Ghia's Table I prints
+        // u = -0.86636 at y = 0.4531 for Re = 3200, a misprint (its neighbours are -0.24
+        // and -0.04): that one point is skipped rather than compared or corrected.
+        let misprint = |s: f64| (self.re - 3200.0).abs() < 1e-9 && vertical && (s - 0.4531).abs() < 1e-9;
+        for (s, reference) in points.into_iter().filter(|(s, _)| *s > 0.0 && *s < 1.0 && !misprint(*s)) {
             let q = if vertical { Vector::<2>::new(0.5, s) } else { Vector::<2>::new(s, 0.5) };
             let value = self.probe(q, if vertical { 0 } else { 1 })?;
             let d = (value - reference).abs() / U;
@@ -238,7 +248,8 @@ impl SceneRun for Cavity {
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
         let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        self.energy = serde_json::from_value(state["energy"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.energy =
+            serde_json::from_value(state["energy"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
         self.sim.restore(sim);
         Ok(())
     }

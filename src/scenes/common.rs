@@ -19,11 +19,31 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
         Spec::choice("kernel", KernelKind::NAMES, "quintic_spline", "smoothing kernel"),
         Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
         Spec::choice("corrections", &["all", "none"], "all", "the CTVF correction terms, together"),
-        Spec::choice("corr_continuity", SWITCH, "auto", "the correction of eq. (25); auto follows `corrections`"),
-        Spec::choice("corr_pressure", SWITCH, "auto", "the corrections of eq. (26); auto follows `corrections`"),
-        Spec::choice("corr_momentum", SWITCH, "auto", "the -u div(u~ - u) term of eq. (19); auto follows `corrections`"),
+        Spec::choice(
+            "corr_continuity",
+            SWITCH,
+            "auto",
+            "the correction of eq. (25); auto follows `corrections`",
+        ),
+        Spec::choice(
+            "corr_pressure",
+            SWITCH,
+            "auto",
+            "the corrections of eq. (26); auto follows `corrections`",
+        ),
+        Spec::choice(
+            "corr_momentum",
+            SWITCH,
+            "auto",
+            "the -u div(u~ - u) term of eq. (19); auto follows `corrections`",
+        ),
         Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
-        Spec::float("ipst_tol", 0.02, Bound::Positive, "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)"),
+        Spec::float(
+            "ipst_tol",
+            0.02,
+            Bound::Positive,
+            "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
+        ),
         Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
     ]
 }

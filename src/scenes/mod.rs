@@ -7,6 +7,7 @@ pub mod cavity;
 pub mod common;
 pub mod geometry;
 pub mod harness;
+pub mod hydrostatic_tank;
 pub mod params;
 pub mod taylor_green;
 
@@ -67,7 +68,7 @@ pub struct SceneEntry {
 }
 
 /// Every scene.
-pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY, cavity::ENTRY];
+pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY, cavity::ENTRY, hydrostatic_tank::ENTRY];
 
 /// Looks a scene up by name.
 pub fn find(name: &str) -> Result<&'static SceneEntry, String> {

@@ -13,8 +13,8 @@
 //! - `p_l1_final`: mean |(p - mean p) - (p_e - mean p_e)| over max |p_e| at tf;
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
-use super::params::{Bound, Params, Spec};
 use super::common::{fluid_scheme, scheme_params, write_fluid, FluidConstants};
+use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;

@@ -1,0 +1,193 @@
+//! Fluid at rest in a tank under gravity (a check of the wall boundary condition, CTVF
+//! sec. 3.6): a column of `width` x `height` in three layers of wall particles, open at the
+//! top, started from the hydrostatic pressure. rho0 = 1000 kg/m^3, g = 9.81 m/s^2,
+//! c0 = 10 sqrt(2 g H), continuity density, EDAC pressure, artificial viscosity `alpha`.
+//!
+//! Metrics: `pressure_rel_error`, the RMS over the fluid of (p - rho0 g (H - y)) /
+//! (rho0 g H) at the end; `max_speed`, the largest |u| over sqrt(g H) at the end (spurious
+//! currents); `particles_outside`, the fluid particles found beyond the wall surfaces
+//! (none may be). The free surface is not treated (CTVF sec. 3.4-3.5 is not implemented yet),
+//! so the scene runs without particle shifting (`scheme = ctvf`, `pst = none`).
+
+use super::common::{fluid_scheme, scheme_params, write_fluid, write_wall, FluidConstants};
+use super::geometry::{box_walls, lattice};
+use super::params::{Bound, Params, Spec};
+use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::math::Vector;
+use crate::solver::nnps::Domain;
+use crate::solver::particles::{Fluid, FluidInit, Wall};
+use crate::solver::scheme::DensityModel;
+use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const RHO0: f64 = 1000.0;
+const G: f64 = 9.81;
+const LAYERS: usize = 3;
+
+/// The registry entry.
+pub const ENTRY: SceneEntry = SceneEntry {
+    name: "hydrostatic_tank",
+    dim: 2,
+    about: "Fluid at rest in a tank under gravity: wall pressure and spurious currents",
+    params,
+    build,
+    metrics: &["pressure_rel_error", "max_speed", "particles_outside"],
+};
+
+fn params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::float("dx", 0.02, Bound::Positive, "particle spacing (m)"),
+        Spec::float("height", 1.0, Bound::Positive, "fluid column height H (m)"),
+        Spec::float("width", 1.0, Bound::Positive, "tank width (m)"),
+        Spec::float("alpha", 0.05, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
+    ];
+    v.extend(scheme_params("none"));
+    v.extend(common_params(2.0));
+    v
+}
+
+struct Tank {
+    sim: Simulation<2>,
+    height: f64,
+    width: f64,
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
+    for (key, len) in [("height", height), ("width", width)] {
+        if len < 4.0 * dx {
+            return Err(format!(
+                "scene `hydrostatic_tank`: `{key}` = {len} is less than 4 particle spacings (dx = {dx})"
+            ));
+        }
+    }
+    if p.str("scheme") != "ctvf" || p.str("pst") != "none" {
+        return Err(format!(
+            "scene `hydrostatic_tank`: `scheme` = {}, `pst` = {}: this free-surface scene needs scheme = ctvf with pst = none (free-surface shifting, CTVF sec. 3.5, is not implemented yet)",
+            p.str("scheme"),
+            p.str("pst")
+        ));
+    }
+    let c0 = 10.0 * (2.0 * G * height).sqrt();
+    let constants = FluidConstants {
+        rho0: RHO0,
+        c0,
+        u_ref: (2.0 * G * height).sqrt(),
+        dx,
+        nu: None,
+        alpha: Some(p.float("alpha")),
+        density: DensityModel::Continuity,
+        gravity: [0.0, -G, 0.0],
+        internal_flow: false,
+    };
+    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {
+        return Err(format!(
+            "scene `hydrostatic_tank`: kernel support {:.3} dx exceeds the {LAYERS} wall layers: lower `hdx` (= {})",
+            kernel.support() * h / dx,
+            p.float("hdx")
+        ));
+    }
+    let x = lattice(0.0, width, 0.0, height, dx);
+    let n = x.len();
+    let p0: Vec<f64> = x.iter().map(|x| RHO0 * G * (height - x[1])).collect();
+    let init =
+        FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: p0, x };
+    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
+    let walls = box_walls(width, 1.5 * height, dx, LAYERS, false);
+    let wall = Wall::new(
+        "wall",
+        walls.iter().map(|w| w.0).collect(),
+        vec![Vector::zeros(); walls.len()],
+        walls.iter().map(|w| w.1).collect(),
+        RHO0 * dx * dx,
+        RHO0,
+        c0,
+    )?;
+    let edge = (LAYERS as f64 + 0.5) * dx;
+    let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
+    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: 10.0 };
+    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time, true)
+        .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
+    Ok(Box::new(Tank { sim, height, width }))
+}
+
+impl Tank {
+    /// (pressure error, largest speed), normalised.
+    fn errors(&self) -> (f64, f64) {
+        let f = self.sim.fluid();
+        let scale = RHO0 * G * self.height;
+        let order = f.by_id(&(0..f.len() as u32).collect::<Vec<_>>());
+        let (mut e2, mut umax) = (0.0, 0.0f64);
+        for &k in &order {
+            let k = k as usize;
+            let d = (f.p[k] - RHO0 * G * (self.height - f.x[k][1])) / scale;
+            e2 += d * d;
+            umax = umax.max(f.u[k].norm());
+        }
+        ((e2 / f.len() as f64).sqrt(), umax / (G * self.height).sqrt())
+    }
+}
+
+impl SceneRun for Tank {
+    fn particles(&self) -> usize {
+        self.sim.fluid().len() + self.sim.walls.as_ref().map_or(0, |w| w.wall.len())
+    }
+    fn time(&self) -> f64 {
+        self.sim.time()
+    }
+    fn steps(&self) -> u64 {
+        self.sim.steps()
+    }
+    fn plan(&self) -> String {
+        let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
+        format!(
+            "body `fluid`: {} particles, h = {:.4e}; body `wall`: {w} particles ({LAYERS} layers, open top)\n{}",
+            self.sim.fluid().len(),
+            self.sim.fluid().h,
+            self.sim.state.scheme
+        )
+    }
+    fn advance(
+        &mut self,
+        t_stop: f64,
+        t_end: f64,
+        on_step: &mut dyn FnMut(f64, u64) -> bool,
+    ) -> Result<bool, Divergence> {
+        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
+    }
+    fn sample(&mut self) -> Vec<(&'static str, f64)> {
+        let (p_err, umax) = self.errors();
+        vec![("t", self.sim.time()), ("max_speed", umax), ("pressure_rel_error", p_err)]
+    }
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
+        let name = format!("fluid_{index:05}.vtu");
+        write_fluid(&dir.join(&name), self.sim.fluid(), Vec::new())?;
+        let mut files = vec![("fluid".to_string(), name)];
+        if let Some(ws) = &self.sim.walls {
+            let name = format!("wall_{index:05}.vtu");
+            write_wall(&dir.join(&name), &ws.wall)?;
+            files.push(("wall".into(), name));
+        }
+        Ok(files)
+    }
+    fn metrics(&self) -> BTreeMap<String, f64> {
+        let (p_err, umax) = self.errors();
+        let w = self.width;
+        let outside = self.sim.fluid().x.iter().filter(|x| x[0] < 0.0 || x[0] > w || x[1] < 0.0).count();
+        BTreeMap::from([
+            ("pressure_rel_error".to_string(), p_err),
+            ("max_speed".to_string(), umax),
+            ("particles_outside".to_string(), outside as f64),
+        ])
+    }
+    fn save_state(&self) -> serde_json::Value {
+        serde_json::json!({ "sim": &self.sim.state })
+    }
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
+        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.sim.restore(sim);
+        Ok(())
+    }
+}
