@@ -1115,9 +1115,7 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         let root = with_reference("y,Re100,Re400\n0.0,0.0,0.0\n0.5,-0.2,-0.1\n1.0,1.0,1.0\n");
         let pr = p_in(root.path(), &format!("{GOOD}{PROFILE}")).unwrap();
         let f = pr.figures.iter().find(|f| f.id == "prof").unwrap();
-        let FigureKind::Profile { file, x, y, reference: Some(r) } = &f.kind else {
-            panic!("{:?}", f.kind)
-        };
+        let FigureKind::Profile { file, x, y, reference: Some(r) } = &f.kind else { panic!("{:?}", f.kind) };
         assert_eq!((file.as_str(), x.as_str(), y.as_str()), ("centerline_u.csv", "u", "y"));
         assert_eq!(r.x, [0.0, -0.2, 1.0]);
         assert_eq!(r.y, [0.0, 0.5, 1.0]);
@@ -1151,7 +1149,10 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         let e = p_in(root.path(), &src.replace("y = \"y\", label", "y = \"z\", label")).unwrap_err();
         assert!(e.contains(&at) && e.contains("`figures.prof.reference.y`") && e.contains("`z`"), "{e}");
         let e = p_in(root.path(), &src.replace("\"ref.csv\"", "\"nope.csv\"")).unwrap_err();
-        assert!(e.contains(&at) && e.contains("`figures.prof.reference.file`") && e.contains("nope.csv"), "{e}");
+        assert!(
+            e.contains(&at) && e.contains("`figures.prof.reference.file`") && e.contains("nope.csv"),
+            "{e}"
+        );
         let e = p_in(root.path(), &src.replace("\"ref.csv\"", "\"../ref.csv\"")).unwrap_err();
         assert!(e.contains("reference.file") && e.contains("file name"), "{e}");
         let e = p_in(root.path(), &src.replace("Ghia et al. 1982\" }", "G\", colour = 1 }")).unwrap_err();
