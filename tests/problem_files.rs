@@ -146,3 +146,30 @@ fn cavity_presets_and_reference_points() {
     assert_eq!(r.y_column, "Re1000");
     assert!(quick.bounds.is_empty(), "bounds are measured by the lead once the scene exists");
 }
+
+/// Every figure and table of every problem is drawn with no results at all (as after a
+/// fresh checkout with `--plot-only`): empty curves, the published points, "no result".
+#[test]
+fn every_problem_plots_without_results() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
+    let tmp = tempfile::tempdir().unwrap();
+    for name in ["cavity", "cavity_stability", "hydrostatic_tank"] {
+        let path = dir.join(format!("{name}.toml"));
+        let src = std::fs::read_to_string(&path).unwrap();
+        let p = registry::parse_with(&path, &src, "quick", find).unwrap();
+        let section =
+            sphrepro::automation::study::regenerate(&p, &tmp.path().join("out"), tmp.path()).unwrap();
+        let figures = section
+            .items
+            .iter()
+            .filter(|i| matches!(i, sphrepro::automation::report::Item::Figure { .. }))
+            .count();
+        assert!(figures >= p.figures.len(), "{name}");
+        for f in &p.figures {
+            assert!(!f.paper.is_empty(), "{name}/{}: no `paper` line", f.id);
+        }
+    }
+    assert!(tmp.path().join("figures/fig14a_cavity_u_re100.svg").exists());
+    let svg = std::fs::read_to_string(tmp.path().join("figures/fig15b_cavity_v_re1000.svg")).unwrap();
+    assert!(svg.contains("Ghia et al. 1982"));
+}
