@@ -4,10 +4,10 @@ use crate::solver::integrator;
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
-use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
-    Shifting,
+    Shifting, WallSet,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -95,7 +95,7 @@ fn lap(start: std::time::Instant, acc: &mut f64) -> std::time::Instant {
     now
 }
 
-/// One simulation of one fluid body in a domain.
+/// One simulation of one fluid body, optionally bounded by walls, in a domain.
 pub struct Simulation<const D: usize> {
     /// The box.
     pub domain: Domain<D>,
@@ -105,6 +105,8 @@ pub struct Simulation<const D: usize> {
     pub time_settings: TimeSettings,
     /// Everything that evolves.
     pub state: State<D>,
+    /// The walls, if the scene has any: not integrated, so not part of the state.
+    pub walls: Option<WallSet<D>>,
     cells: CellList<D>,
     neighbours: KernelList<D>,
     passes: FluidPasses<D>,
@@ -119,6 +121,7 @@ impl<const D: usize> Simulation<D> {
         domain: Domain<D>,
         kernel: Kernel,
         fluid: Fluid<D>,
+        wall: Option<Wall<D>>,
         mut scheme: FluidScheme,
         time_settings: TimeSettings,
         free_surface: bool,
@@ -132,48 +135,49 @@ impl<const D: usize> Simulation<D> {
                 ));
             }
         }
-        let mut cells = CellList::new(domain, radius);
         let n = fluid.len();
-        let transport = scheme.transport.is_some();
         let rates = FluidRates::new(
             n,
             matches!(scheme.pressure, PressureModel::Edac { .. }),
             scheme.density == DensityModel::Continuity,
-            transport,
+            scheme.transport.is_some(),
         );
-        let mut state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme, ipst_iterations: 0 };
-        let mut neighbours = KernelList::new();
-        Self::rebuild(&domain, &kernel, &mut cells, &mut neighbours, &mut state.fluid);
-        if let Some(t) = scheme.transport.as_mut() {
-            if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
-                *chi_ref = ipst_chi_reference(&state.fluid, &neighbours, free_surface);
-            }
-        }
-        state.scheme = scheme;
-        let passes = FluidPasses::new();
+        let state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme, ipst_iterations: 0 };
         let mut sim = Self {
             domain,
             kernel,
             time_settings,
             state,
-            cells,
-            neighbours,
-            passes,
+            walls: wall.map(|w| WallSet::new(w, domain, radius)),
+            cells: CellList::new(domain, radius),
+            neighbours: KernelList::new(),
+            passes: FluidPasses::new(),
             times: PhaseTimes::default(),
         };
+        sim.rebuild();
+        if let Some(t) = scheme.transport.as_mut() {
+            if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
+                *chi_ref =
+                    ipst_chi_reference(&sim.state.fluid, &sim.neighbours, sim.walls.as_ref(), free_surface);
+            }
+        }
+        sim.state.scheme = scheme;
         sim.state.u_max = sim.max_speed();
         // Initial accelerations for the first half kick; the pressure is the initial one.
         if sim.state.scheme.density == DensityModel::Summation {
-            FluidPasses::summation_density(&mut sim.state.fluid, &sim.neighbours);
+            FluidPasses::summation_density(&mut sim.state.fluid, &sim.neighbours, sim.walls.as_ref());
         }
         if let PressureModel::StateEquation { .. } = sim.state.scheme.pressure {
+            let st = &mut sim.state;
             sim.passes.update_density_and_pressure(
-                &mut sim.state.fluid,
+                &mut st.fluid,
                 &sim.neighbours,
-                &sim.state.scheme,
-                &mut sim.state.rates,
+                sim.walls.as_ref(),
+                &st.scheme,
+                &mut st.rates,
                 0.0,
             );
+            sim.extrapolate_walls();
         }
         let dt = sim.nominal_dt();
         sim.evaluate_accelerations(dt);
@@ -186,7 +190,7 @@ impl<const D: usize> Simulation<D> {
     pub fn restore(&mut self, state: State<D>) {
         self.state = state;
         self.cells.update(&self.state.fluid.x);
-        build_kernel_list(&mut self.neighbours, &self.cells, &self.state.fluid, &self.kernel);
+        self.relist();
     }
 
     /// The fluid body.
@@ -209,19 +213,32 @@ impl<const D: usize> Simulation<D> {
         self.state.ipst_iterations
     }
 
-    /// Wraps positions into the box, sorts the particles by cell and lists neighbours.
-    fn rebuild(
-        domain: &Domain<D>,
-        kernel: &Kernel,
-        cells: &mut CellList<D>,
-        nl: &mut KernelList<D>,
-        fluid: &mut Fluid<D>,
-    ) {
+    /// Wraps positions into the box, sorts the particles by cell and lists neighbours;
+    /// then the wall pressure and velocities from the fluid.
+    fn rebuild(&mut self) {
+        let (domain, fluid) = (&self.domain, &mut self.state.fluid);
         fluid.x.par_iter_mut().for_each(|x| domain.wrap(x));
-        cells.update(&fluid.x);
-        fluid.reorder(cells.order());
-        cells.mark_reordered();
-        build_kernel_list(nl, cells, fluid, kernel);
+        self.cells.update(&fluid.x);
+        fluid.reorder(self.cells.order());
+        self.cells.mark_reordered();
+        self.relist();
+    }
+
+    /// The neighbour lists from the current binning, and the wall extrapolation.
+    fn relist(&mut self) {
+        let fluid = &self.state.fluid;
+        build_kernel_list(&mut self.neighbours, &self.cells, fluid, &self.kernel);
+        if let Some(ws) = self.walls.as_mut() {
+            ws.relist(fluid, &self.cells, &self.kernel);
+        }
+        self.extrapolate_walls();
+    }
+
+    /// Eqs. (46)-(52) on the walls from the fluid's current state.
+    fn extrapolate_walls(&mut self) {
+        if let Some(ws) = self.walls.as_mut() {
+            ws.extrapolate(&self.state.fluid, self.state.scheme.gravity_vector());
+        }
     }
 
     /// The time step of eq. (61) from the current largest speed.
@@ -241,12 +258,13 @@ impl<const D: usize> Simulation<D> {
 
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
-        let st = &mut self.state;
-        self.passes.accelerations(&st.fluid, &self.neighbours, &st.scheme, &mut st.rates, dt_nominal);
+        let (st, walls) = (&mut self.state, self.walls.as_ref());
+        self.passes.accelerations(&st.fluid, &self.neighbours, walls, &st.scheme, &mut st.rates, dt_nominal);
         let clock = lap(clock, &mut self.times.accelerations);
         st.ipst_iterations = self.passes.ipst(
             &st.fluid,
             &self.neighbours,
+            walls,
             &self.kernel,
             &st.scheme,
             &mut st.rates,
@@ -271,28 +289,25 @@ impl<const D: usize> Simulation<D> {
             integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
-        Self::rebuild(
-            &self.domain,
-            &self.kernel,
-            &mut self.cells,
-            &mut self.neighbours,
-            &mut self.state.fluid,
-        );
+        self.rebuild();
         let mut clock = lap(clock, &mut self.times.neighbours);
         {
-            let st = &mut self.state;
+            let (st, walls) = (&mut self.state, self.walls.as_ref());
             if st.scheme.density == DensityModel::Summation {
-                FluidPasses::summation_density(&mut st.fluid, &self.neighbours);
+                FluidPasses::summation_density(&mut st.fluid, &self.neighbours, walls);
                 clock = lap(clock, &mut self.times.density);
             }
             self.passes.update_density_and_pressure(
                 &mut st.fluid,
                 &self.neighbours,
+                walls,
                 &st.scheme,
                 &mut st.rates,
                 dt,
             );
         }
+        // The walls follow the updated fluid pressure before the accelerations use it.
+        self.extrapolate_walls();
         lap(clock, &mut self.times.pressure);
         self.evaluate_accelerations(dt_nominal);
         let clock = std::time::Instant::now();

@@ -12,6 +12,7 @@ pub mod edac;
 pub mod momentum;
 pub mod shifting;
 pub mod viscosity;
+pub mod wall;
 
 use crate::solver::math::Vector;
 

@@ -53,16 +53,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     ) {
         let n = points.len();
         assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
-        self.shifts.clear();
-        for code in 0..3usize.pow(D as u32) {
-            let mut wraps = [0i8; D];
-            let mut c = code;
-            for w in wraps.iter_mut() {
-                *w = (c % 3) as i8 - 1;
-                c /= 3;
-            }
-            self.shifts.push(cells.shift(wraps));
-        }
+        self.set_shifts(cells);
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         let shifts = &self.shifts;
         let r2max = cells.radius2();
@@ -116,14 +107,72 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         });
     }
 
+    /// Lists, for every query point, its neighbours among `sources` (binned by `cells`),
+    /// with `payload(x_ij, r2)` per pair: the interaction of two bodies. Query points may
+    /// lie anywhere; periodic images are found as for a body's own list.
+    pub fn build_cross(
+        &mut self,
+        cells: &CellList<D>,
+        sources: &[Vector<D>],
+        queries: &[Vector<D>],
+        payload: impl Fn(Vector<D>, f64) -> P + Sync,
+    ) {
+        let n = queries.len();
+        assert!(sources.len() < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
+        self.set_shifts(cells);
+        self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
+        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
+            chunk.start.clear();
+            chunk.entries.clear();
+            chunk.payload.clear();
+            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+                chunk.start.push(chunk.entries.len() as u32);
+                cells.visit(sources, &queries[i], |j, xij, r2, wraps| {
+                    let mut code = 0u32;
+                    for k in (0..D).rev() {
+                        code = code * 3 + (wraps[k].clamp(-1, 1) + 1) as u32;
+                    }
+                    chunk.entries.push(j as u32 | (code << J_BITS));
+                    chunk.payload.push(payload(xij, r2));
+                });
+            }
+            chunk.start.push(chunk.entries.len() as u32);
+        });
+    }
+
+    fn set_shifts(&mut self, cells: &CellList<D>) {
+        self.shifts.clear();
+        for code in 0..3usize.pow(D as u32) {
+            let mut wraps = [0i8; D];
+            let mut c = code;
+            for w in wraps.iter_mut() {
+                *w = (c % 3) as i8 - 1;
+                c /= 3;
+            }
+            self.shifts.push(cells.shift(wraps));
+        }
+    }
+
     /// Calls `f(j, x_ij, r2, payload)` for every neighbour `j` of point `i` (itself
     /// included), in the order of the cell list. `points` must be the positions the list
     /// was built from.
     #[inline(always)]
-    pub fn for_each<F: FnMut(usize, Vector<D>, f64, &P)>(&self, i: usize, points: &[Vector<D>], mut f: F) {
+    pub fn for_each<F: FnMut(usize, Vector<D>, f64, &P)>(&self, i: usize, points: &[Vector<D>], f: F) {
+        self.for_each_from(i, points[i], points, f);
+    }
+
+    /// As [`for_each`](Self::for_each) for a list between two bodies: query point `i` at
+    /// `xi`, neighbours among `sources`.
+    #[inline(always)]
+    pub fn for_each_from<F: FnMut(usize, Vector<D>, f64, &P)>(
+        &self,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        mut f: F,
+    ) {
         let chunk = &self.chunks[i / CHUNK];
         let l = i % CHUNK;
-        let xi = points[i];
         let range = chunk.start[l] as usize..chunk.start[l + 1] as usize;
         for (&e, p) in chunk.entries[range.clone()].iter().zip(&chunk.payload[range]) {
             let j = (e & J_MASK) as usize;

@@ -2,8 +2,10 @@
 //! declared physics needs.
 
 mod fluid;
+mod wall;
 
 pub use fluid::{Fluid, FluidInit, FluidRates};
+pub use wall::Wall;
 
 /// Permutes `v` by `order` (`v_new[k] = v_old[order[k]]`) through a reusable scratch
 /// buffer, so reordering allocates nothing once the buffers have grown.

@@ -7,8 +7,10 @@
 //! top of every run log.
 
 mod passes;
+mod walls;
 
 pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
+pub use walls::WallSet;
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -293,6 +295,17 @@ impl SchemeName {
                 }
             }
         }
+    }
+}
+
+impl FluidScheme {
+    /// Gravity as a `D`-vector.
+    pub fn gravity_vector<const D: usize>(&self) -> crate::solver::math::Vector<D> {
+        let mut g = crate::solver::math::Vector::<D>::zeros();
+        for d in 0..D.min(3) {
+            g[d] = self.gravity[d];
+        }
+        g
     }
 }
 

@@ -3,7 +3,7 @@
 //! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
 //! for any number of threads.
 
-use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting};
+use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, WallSet};
 use crate::solver::equations::{
     artificial_viscosity, continuity, edac, momentum, shifting, viscosity, Pair, Point,
 };
@@ -31,6 +31,20 @@ pub fn build_kernel_list<const D: usize>(
     nl.build(cells, &fluid.x, |_, r2| k.w_and_grad_factor(r2.sqrt()));
 }
 
+/// Builds the list of the neighbours of `queries` (a body of smoothing length `h`) among
+/// `sources` (binned by `cells`), with the kernel values of each pair.
+pub fn build_kernel_list_cross<const D: usize>(
+    nl: &mut KernelList<D>,
+    cells: &CellList<D>,
+    sources: &[Vector<D>],
+    queries: &[Vector<D>],
+    h: f64,
+    k: &Kernel,
+) {
+    let k = k.scaled(h);
+    nl.build_cross(cells, sources, queries, |_, r2| k.w_and_grad_factor(r2.sqrt()));
+}
+
 #[inline(always)]
 fn pair<const D: usize>(k: &ScaledKernel, xij: Vector<D>, r2: f64) -> Pair<D> {
     let (w, f) = k.w_and_grad_factor(r2.sqrt());
@@ -55,6 +69,46 @@ fn gather_points<const D: usize>(f: &Fluid<D>, out: &mut Vec<Point<D>>) {
     out.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, p)| *p = point(f, u_hat, i));
 }
 
+/// The wall particles as the fluid sees them: with the slip ghost velocities of eqs.
+/// (48)-(49) for the divergence terms, and with the no-slip one of eq. (50) for the viscous
+/// terms.
+fn gather_wall_points<const D: usize>(ws: &WallSet<D>, div: &mut Vec<Point<D>>, visc: &mut Vec<Point<D>>) {
+    let w = &ws.wall;
+    div.clear();
+    visc.clear();
+    for i in 0..w.len() {
+        let (g, m, rho) = (&w.ghost[i], w.m[i], w.rho(i));
+        div.push(Point::new(g.u_slip, g.u_hat_slip, m, rho, g.p));
+        visc.push(Point::new(g.u_noslip, g.u_noslip, m, rho, g.p));
+    }
+}
+
+/// The sources a fluid particle sums over: its own body, then the walls (if any) with
+/// their two views. `f(pair, b, b_viscous, b_is_fluid)`.
+struct Sources<'a, const D: usize> {
+    h: f64,
+    x: &'a [Vector<D>],
+    nl: &'a KernelList<D>,
+    pts: &'a [Point<D>],
+    walls: Option<(&'a WallSet<D>, &'a [Point<D>], &'a [Point<D>])>,
+}
+
+impl<const D: usize> Sources<'_, D> {
+    #[inline(always)]
+    fn for_each(&self, i: usize, mut f: impl FnMut(&Pair<D>, &Point<D>, &Point<D>, bool)) {
+        let h = self.h;
+        self.nl.for_each(i, self.x, |j, xij, r2, kw| {
+            let b = &self.pts[j];
+            f(&cached_pair(h, xij, r2, kw), b, b, true)
+        });
+        if let Some((ws, div, visc)) = self.walls {
+            ws.fluid_to_wall.for_each_from(i, self.x[i], &ws.wall.x, |j, xij, r2, kw| {
+                f(&cached_pair(h, xij, r2, kw), &div[j], &visc[j], false)
+            });
+        }
+    }
+}
+
 /// Scratch state of the fluid passes that must survive between steps without allocating:
 /// the gathered particle views and the IPST work arrays.
 #[derive(Clone, Debug, Default)]
@@ -63,101 +117,120 @@ pub struct FluidPasses<const D: usize> {
     dr: Vec<Vector<D>>,
     chi: Vec<f64>,
     points: Vec<Point<D>>,
+    wall_div: Vec<Point<D>>,
+    wall_visc: Vec<Point<D>>,
 }
 
 impl<const D: usize> FluidPasses<D> {
     /// Empty work space; the arrays grow on first use (IPST's only when it is declared).
     pub fn new() -> Self {
-        Self { x_shift: Vec::new(), dr: Vec::new(), chi: Vec::new(), points: Vec::new() }
+        Self::default()
     }
 
-    /// Summation density, `rho_a = sum_b m_b W_ab`.
-    pub fn summation_density(fluid: &mut Fluid<D>, nl: &KernelList<D>) {
+    /// Gathers the views of the fluid (and walls) for a pass.
+    fn gather<'a>(
+        &'a mut self,
+        fluid: &'a Fluid<D>,
+        nl: &'a KernelList<D>,
+        walls: Option<&'a WallSet<D>>,
+    ) -> Sources<'a, D> {
+        gather_points(fluid, &mut self.points);
+        if let Some(ws) = walls {
+            gather_wall_points(ws, &mut self.wall_div, &mut self.wall_visc);
+        }
+        Sources {
+            h: fluid.h,
+            x: &fluid.x,
+            nl,
+            pts: &self.points,
+            walls: walls.map(|ws| (ws, &self.wall_div[..], &self.wall_visc[..])),
+        }
+    }
+
+    /// Summation density, `rho_a = sum_b m_b W_ab` over the fluid and the walls.
+    pub fn summation_density(fluid: &mut Fluid<D>, nl: &KernelList<D>, walls: Option<&WallSet<D>>) {
         let (x, m) = (&fluid.x, &fluid.m);
         fluid.rho.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, rho)| {
             let mut s = 0.0;
             nl.for_each(i, x, |j, _, _, &(w, _)| s += m[j] * w);
+            if let Some(ws) = walls {
+                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, _, _, &(w, _)| s += ws.wall.m[j] * w);
+            }
             *rho = s;
         });
     }
 
     /// Pass A: the density and pressure rates (eqs. 25 and 26), then their explicit
-    /// update over `dt` (eqs. 56-57); or the state equation (8).
+    /// update over `dt` (eqs. 56-57); or the state equation (8). Walls enter through their
+    /// extrapolated pressure and slip velocities.
     pub fn update_density_and_pressure(
         &mut self,
         fluid: &mut Fluid<D>,
         nl: &KernelList<D>,
+        walls: Option<&WallSet<D>>,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
-        let h = fluid.h;
-        gather_points(fluid, &mut self.points);
-        let pts = &self.points;
         let continuity_on = s.density == DensityModel::Continuity;
         let corr = s.transport.map(|t| t.corrections);
         let continuity_corr = corr.is_some_and(|c| c.continuity);
+        let pressure_corr = corr.is_some_and(|c| c.pressure);
+        let edac = match s.pressure {
+            PressureModel::Edac { cs, nu } => Some((cs * cs, nu)),
+            PressureModel::StateEquation { .. } => None,
+        };
+        if continuity_on || edac.is_some() {
+            let src = self.gather(fluid, nl, walls);
+            let rate = |i: usize| -> (f64, f64) {
+                let a = &src.pts[i];
+                let (mut dp, mut drho) = (0.0, 0.0);
+                src.for_each(i, |ab, b, _, _| {
+                    if let Some((cs2, nu)) = edac {
+                        dp += edac::compressibility(a, b, ab, cs2) + edac::diffusion(a, b, ab, nu);
+                        if pressure_corr {
+                            dp += edac::transport_correction(a, b, ab);
+                        }
+                    }
+                    if continuity_on {
+                        drho += continuity::transport_divergence(a, b, ab);
+                        if continuity_corr {
+                            drho += continuity::correction(a, b, ab);
+                        }
+                    }
+                });
+                (dp, drho)
+            };
+            match (edac.is_some(), continuity_on) {
+                (true, true) => rates
+                    .dp
+                    .par_iter_mut()
+                    .zip(rates.drho.par_iter_mut())
+                    .enumerate()
+                    .with_min_len(MIN_LEN)
+                    .for_each(|(i, (dp, drho))| (*dp, *drho) = rate(i)),
+                (true, false) => rates
+                    .dp
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_min_len(MIN_LEN)
+                    .for_each(|(i, dp)| *dp = rate(i).0),
+                (false, _) => rates
+                    .drho
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_min_len(MIN_LEN)
+                    .for_each(|(i, d)| *d = rate(i).1),
+            }
+        }
+        if continuity_on {
+            apply(&mut fluid.rho, &rates.drho, dt);
+        }
         match s.pressure {
+            PressureModel::Edac { .. } => apply(&mut fluid.p, &rates.dp, dt),
             PressureModel::StateEquation { c0, rho0 } => {
-                if continuity_on {
-                    let x = &fluid.x;
-                    rates.drho.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, out)| {
-                        let a = &pts[i];
-                        let mut s = 0.0;
-                        nl.for_each(i, x, |j, xij, r2, kw| {
-                            let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
-                            s += continuity::transport_divergence(&a, &b, &ab);
-                            if continuity_corr {
-                                s += continuity::correction(&a, &b, &ab);
-                            }
-                        });
-                        *out = s;
-                    });
-                    apply(&mut fluid.rho, &rates.drho, dt);
-                }
                 let c2 = c0 * c0;
                 fluid.p.par_iter_mut().zip(&fluid.rho).for_each(|(p, &rho)| *p = c2 * (rho - rho0));
-            }
-            PressureModel::Edac { cs, nu } => {
-                let cs2 = cs * cs;
-                let pressure_corr = corr.is_some_and(|c| c.pressure);
-                let x = &fluid.x;
-                let rate = |i: usize| -> (f64, f64) {
-                    let a = &pts[i];
-                    let (mut dp, mut drho) = (0.0, 0.0);
-                    nl.for_each(i, x, |j, xij, r2, kw| {
-                        let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
-                        dp += edac::compressibility(&a, &b, &ab, cs2) + edac::diffusion(&a, &b, &ab, nu);
-                        if pressure_corr {
-                            dp += edac::transport_correction(&a, &b, &ab);
-                        }
-                        if continuity_on {
-                            drho += continuity::transport_divergence(&a, &b, &ab);
-                            if continuity_corr {
-                                drho += continuity::correction(&a, &b, &ab);
-                            }
-                        }
-                    });
-                    (dp, drho)
-                };
-                if continuity_on {
-                    rates
-                        .dp
-                        .par_iter_mut()
-                        .zip(rates.drho.par_iter_mut())
-                        .enumerate()
-                        .with_min_len(MIN_LEN)
-                        .for_each(|(i, (dp, drho))| (*dp, *drho) = rate(i));
-                    apply(&mut fluid.rho, &rates.drho, dt);
-                } else {
-                    rates
-                        .dp
-                        .par_iter_mut()
-                        .enumerate()
-                        .with_min_len(MIN_LEN)
-                        .for_each(|(i, dp)| *dp = rate(i).0);
-                }
-                apply(&mut fluid.p, &rates.dp, dt);
             }
         }
     }
@@ -165,21 +238,20 @@ impl<const D: usize> FluidPasses<D> {
     /// Pass B: the acceleration (eq. 27 or its Adami form) and, for the shifting
     /// techniques that are sums over neighbours, the homogenisation acceleration.
     /// `dt` is the step the homogenisation will be applied over (eq. 36 divides by it).
+    /// Walls act through their pressure (pressure gradient), their no-slip ghost velocity
+    /// (viscosity) and as neighbours in the shifting; the transport-velocity terms
+    /// (artificial stress, momentum correction) sum over the fluid only.
     pub fn accelerations(
         &mut self,
         fluid: &Fluid<D>,
         nl: &KernelList<D>,
+        walls: Option<&WallSet<D>>,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
-        let h = fluid.h;
-        gather_points(fluid, &mut self.points);
-        let pts = &self.points;
-        let mut g = Vector::<D>::zeros();
-        for d in 0..D.min(3) {
-            g[d] = s.gravity[d];
-        }
+        let src = self.gather(fluid, nl, walls);
+        let g = s.gravity_vector::<D>();
         let shifting = s.transport.map(|t| t.shifting);
         let momentum_corr = s.transport.is_some_and(|t| t.corrections.momentum);
         let transport = s.transport.is_some();
@@ -189,46 +261,47 @@ impl<const D: usize> FluidPasses<D> {
             _ => 0.0,
         };
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
-            let a = &pts[i];
+            let a = &src.pts[i];
             let mut acc = Vector::<D>::zeros();
             let mut ac = Vector::<D>::zeros();
             // BQL: the reference weights and the neighbour-mean pressure, combined at the end.
             let (mut c_ref, mut p_sum, mut n_nb) = (Vector::<D>::zeros(), 0.0, 0usize);
-            nl.for_each(i, &fluid.x, |j, xij, r2, kw| {
-                let (ab, b) = (cached_pair(h, xij, r2, kw), &pts[j]);
+            src.for_each(i, |ab, b, b_visc, b_fluid| {
                 match s.pressure_gradient {
                     PressureGradient::Symmetric { bql } => {
-                        acc += momentum::pressure_gradient(&a, &b, &ab);
+                        acc += momentum::pressure_gradient(a, b, ab);
                         if bql {
-                            c_ref += momentum::pressure_reference_weight(&a, &b, &ab);
+                            c_ref += momentum::pressure_reference_weight(a, b, ab);
                         }
                     }
                     PressureGradient::Adami { bql } => {
-                        acc += momentum::pressure_gradient_adami(&a, &b, &ab);
+                        acc += momentum::pressure_gradient_adami(a, b, ab);
                         if bql {
-                            c_ref += momentum::adami_weight(&a, &b, &ab);
+                            c_ref += momentum::adami_weight(a, b, ab);
                         }
                     }
                 }
                 p_sum += b.p;
                 n_nb += 1;
                 if let Some(nu) = s.viscosity {
-                    acc += viscosity::morris(&a, &b, &ab, nu);
+                    acc += viscosity::morris(a, b_visc, ab, nu);
                 }
                 if let Some((alpha, c)) = s.artificial_viscosity {
-                    acc += artificial_viscosity::monaghan(&a, &b, &ab, alpha, c);
+                    acc += artificial_viscosity::monaghan(a, b_visc, ab, alpha, c);
                 }
                 if transport {
-                    acc += momentum::artificial_stress(&a, &b, &ab);
-                    if momentum_corr {
-                        acc += momentum::transport_divergence_correction(&a, &b, &ab);
+                    if b_fluid {
+                        acc += momentum::artificial_stress(a, b, ab);
+                        if momentum_corr {
+                            acc += momentum::transport_divergence_correction(a, b, ab);
+                        }
                     }
                     match shifting {
                         Some(Shifting::BackgroundPressure { pb }) => {
-                            ac += shifting::background_pressure(&a, &b, &ab, pb)
+                            ac += shifting::background_pressure(a, b, ab, pb)
                         }
                         Some(Shifting::Sun2019 { w_dx, r, n, .. }) => {
-                            ac += shifting::sun2019(&b, &ab, w_dx, r, n)
+                            ac += shifting::sun2019(b, ab, w_dx, r, n)
                         }
                         _ => {}
                     }
@@ -260,17 +333,20 @@ impl<const D: usize> FluidPasses<D> {
     /// IPST (eqs. 37-41): move copies of the particles by `U_max dt sum V_b n_ab W_ab` until
     /// `|max chi - chi_ref| <= tol chi_ref` (eq. 39, chi of eq. 40) or `max_iter` moves,
     /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41). The particles themselves are not
-    /// moved: the kick of the next step applies the displacement through u~.
+    /// moved: the kick of the next step applies the displacement through u~. Walls are
+    /// fixed neighbours.
     ///
-    /// The iterations reuse the step's neighbour list with the kernel re-evaluated at the
+    /// The iterations reuse the step's neighbour lists with the kernel re-evaluated at the
     /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
     /// are those entering the support from outside it during the iterations, whose kernel
     /// value is of the fifth order in the distance they moved in (quintic spline).
     /// Returns the number of moves made.
+    #[allow(clippy::too_many_arguments)]
     pub fn ipst(
         &mut self,
         fluid: &Fluid<D>,
         nl: &KernelList<D>,
+        walls: Option<&WallSet<D>>,
         k: &Kernel,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
@@ -286,18 +362,23 @@ impl<const D: usize> FluidPasses<D> {
         self.dr.resize(n, Vector::zeros());
         self.chi.resize(n, 0.0);
         // The volumes gathered by `accelerations` at these positions.
-        let pts = &self.points;
+        let (pts, wall_pts) = (&self.points, &self.wall_div);
         let mut iterations = 0;
         while iterations < max_iter {
             let xs: &[Vector<D>] = &self.x_shift;
             self.dr.par_iter_mut().zip(self.chi.par_iter_mut()).enumerate().with_min_len(MIN_LEN).for_each(
                 |(i, (dr, chi))| {
                     let (mut d, mut x) = (Vector::<D>::zeros(), 0.0);
-                    nl.for_each(i, xs, |j, xij, r2, _| {
-                        let (ab, b) = (pair(&k, xij, r2), &pts[j]);
-                        d += shifting::ipst_displacement(b, &ab);
-                        x += shifting::ipst_chi(&ab);
-                    });
+                    let mut add = |ab: &Pair<D>, b: &Point<D>| {
+                        d += shifting::ipst_displacement(b, ab);
+                        x += shifting::ipst_chi(ab);
+                    };
+                    nl.for_each(i, xs, |j, xij, r2, _| add(&pair(&k, xij, r2), &pts[j]));
+                    if let Some(ws) = walls {
+                        ws.fluid_to_wall.for_each_from(i, xs[i], &ws.wall.x, |j, xij, r2, _| {
+                            add(&pair(&k, xij, r2), &wall_pts[j])
+                        });
+                    }
                     *dr = d * (u_max * dt);
                     *chi = x;
                 },
@@ -324,13 +405,21 @@ impl<const D: usize> FluidPasses<D> {
 /// chi_ref of eq. (39): the mean of `chi = h^2 sum W` over the initial configuration for
 /// internal flows (the authors' internal-flow choice: a perturbed lattice has no single
 /// value), the maximum with a free surface (CTVF sec. 3.3.2).
-pub fn ipst_chi_reference<const D: usize>(fluid: &Fluid<D>, nl: &KernelList<D>, free_surface: bool) -> f64 {
+pub fn ipst_chi_reference<const D: usize>(
+    fluid: &Fluid<D>,
+    nl: &KernelList<D>,
+    walls: Option<&WallSet<D>>,
+    free_surface: bool,
+) -> f64 {
     let chi: Vec<f64> = (0..fluid.len())
         .map(|i| {
             let mut s = 0.0;
-            nl.for_each(i, &fluid.x, |_, xij, r2, kw| {
-                s += shifting::ipst_chi(&cached_pair(fluid.h, xij, r2, kw))
-            });
+            let mut add =
+                |xij, r2, kw: (f64, f64)| s += shifting::ipst_chi(&cached_pair(fluid.h, xij, r2, &kw));
+            nl.for_each(i, &fluid.x, |_, xij, r2, &kw| add(xij, r2, kw));
+            if let Some(ws) = walls {
+                ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, xij, r2, &kw| add(xij, r2, kw));
+            }
             s
         })
         .collect();
