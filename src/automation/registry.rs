@@ -89,6 +89,12 @@ struct FigureFile {
     #[serde(default)]
     field: Option<String>,
     #[serde(default)]
+    file: Option<String>,
+    #[serde(default)]
+    x_label: Option<String>,
+    #[serde(default)]
+    reference: Option<Spanned<ReferenceFile>>,
+    #[serde(default)]
     max: Option<f64>,
     #[serde(default)]
     converges: bool,
@@ -96,6 +102,18 @@ struct FigureFile {
     lower: Option<SelectFile>,
     #[serde(default)]
     higher: Option<SelectFile>,
+}
+
+/// Published points a `profile` figure is drawn against: two columns of a CSV file in
+/// `reference_data/`.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReferenceFile {
+    file: String,
+    x: String,
+    y: String,
+    #[serde(default)]
+    label: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -209,6 +227,37 @@ pub enum FigureKind {
         /// Above this value of the metric a case that completed is inaccurate.
         max: f64,
     },
+    /// Column `y` against column `x` of a CSV file in each case folder (e.g. a velocity
+    /// profile written at the end of the run), one curve per case, with optional
+    /// published points.
+    Profile {
+        /// File name in the case folder (e.g. `centerline_u.csv`).
+        file: String,
+        /// Column on the horizontal axis.
+        x: String,
+        /// Column on the vertical axis.
+        y: String,
+        /// Published points drawn as markers.
+        reference: Option<Reference>,
+    },
+}
+
+/// Published points of a [`FigureKind::Profile`], read and checked when the problem file
+/// is loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reference {
+    /// The CSV file (under `reference_data/`).
+    pub path: PathBuf,
+    /// Legend entry.
+    pub label: String,
+    /// Column on the horizontal axis.
+    pub x_column: String,
+    /// Column on the vertical axis.
+    pub y_column: String,
+    /// Its values, one per row.
+    pub x: Vec<f64>,
+    /// Its values, one per row.
+    pub y: Vec<f64>,
 }
 
 /// A figure a problem regenerates.
@@ -226,6 +275,8 @@ pub struct Figure {
     pub paper: String,
     /// Cases drawn.
     pub select: Select,
+    /// X-axis label (with units; `profile` only).
+    pub x_label: Option<String>,
     /// Y-axis label (with units).
     pub y_label: Option<String>,
     /// Logarithmic y axis.
@@ -360,14 +411,35 @@ pub fn load(path: &Path, preset: &str) -> Result<Problem, String> {
     parse(path, &src, preset)
 }
 
-/// [`load`] from a string (`path` names it in errors).
+/// The folder of published curves for the problem file at `path`: `reference_data/` next
+/// to the problems folder (`problems/x.toml` -> `reference_data/`).
+pub fn reference_dir(path: &Path) -> PathBuf {
+    let problems = path.parent().unwrap_or(Path::new(""));
+    match problems.parent() {
+        Some(root) => root.join("reference_data"),
+        None => problems.join("..").join("reference_data"),
+    }
+}
+
+/// [`load`] from a string (`path` names it in errors and locates `reference_data/`).
 pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
+    parse_with(path, src, preset, scenes::find)
+}
+
+/// [`parse`] with the scenes looked up by `find` (tests validate problem files against
+/// declared scene contracts with it).
+pub fn parse_with(
+    path: &Path,
+    src: &str,
+    preset: &str,
+    find: fn(&str) -> Result<&'static SceneEntry, String>,
+) -> Result<Problem, String> {
     let loc = Loc { path, src };
     let file: ProblemFile = toml::from_str(src).map_err(|e| {
         let line = e.span().map(|s| loc.line(s.start)).unwrap_or(1);
         format!("{}:{line}: {}", path.display(), e.message().trim_end().replace('\n', " "))
     })?;
-    let scene = scenes::find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
+    let scene = find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     if !valid_name(&name) {
         return Err(format!(
@@ -699,14 +771,40 @@ fn expand(
                     max: f.max.ok_or_else(|| loc.err(span.clone(), &key, "kind `stability` needs `max`"))?,
                 }
             }
+            "profile" => {
+                let file_name = need("file", &f.file)?;
+                if !valid_name(&file_name) || file_name.starts_with('.') {
+                    return Err(loc.err(
+                        span,
+                        &format!("{key}.file"),
+                        format!("`{file_name}` must be a file name in the case folder (letters, digits, `.`, `_`, `-`)"),
+                    ));
+                }
+                let reference = match &f.reference {
+                    Some(r) => Some(reference(loc, r.span(), &key, r.get_ref())?),
+                    None => None,
+                };
+                FigureKind::Profile { file: file_name, x: need("x", &f.x)?, y: need("y", &f.y)?, reference }
+            }
             other => {
                 return Err(loc.err(
                     span,
                     &key,
-                    format!("unknown kind `{other}`; kinds: timeseries, particles, trade, stability"),
+                    format!(
+                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability, profile"
+                    ),
                 ))
             }
         };
+        for (k, set) in [
+            ("file", f.file.is_some()),
+            ("reference", f.reference.is_some()),
+            ("x_label", f.x_label.is_some()),
+        ] {
+            if set && !matches!(kind, FigureKind::Profile { .. }) {
+                return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `profile` takes `{k}`")));
+            }
+        }
         if (f.converges || f.lower.is_some()) && f.metric.is_none() {
             return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
         }
@@ -731,6 +829,7 @@ fn expand(
             caption: f.caption.clone(),
             paper: f.paper.clone(),
             select,
+            x_label: f.x_label.clone(),
             y_label: f.y_label.clone(),
             log_y: f.log_y,
             metric: f.metric.clone(),
@@ -806,6 +905,74 @@ fn expand(
         figures,
         tables,
         bounds,
+    })
+}
+
+/// Reads and checks the published points of a `profile` figure: the file exists under
+/// `reference_data/`, has both columns, and every value is a number.
+fn reference(
+    loc: &Loc,
+    span: std::ops::Range<usize>,
+    key: &str,
+    r: &ReferenceFile,
+) -> Result<Reference, String> {
+    let key = format!("{key}.reference");
+    if !valid_name(&r.file) || r.file.starts_with('.') {
+        return Err(loc.err(
+            span,
+            &format!("{key}.file"),
+            format!("`{}` must be a file name in reference_data/ (letters, digits, `.`, `_`, `-`)", r.file),
+        ));
+    }
+    let path = reference_dir(loc.path).join(&r.file);
+    let mut rd = csv::Reader::from_path(&path)
+        .map_err(|e| loc.err(span.clone(), &format!("{key}.file"), format!("{}: {e}", path.display())))?;
+    let headers = rd
+        .headers()
+        .map_err(|e| loc.err(span.clone(), &format!("{key}.file"), format!("{}: {e}", path.display())))?
+        .clone();
+    let col = |which: &str, name: &str| {
+        headers.iter().position(|h| h.trim() == name).ok_or_else(|| {
+            loc.err(
+                span.clone(),
+                &format!("{key}.{which}"),
+                format!(
+                    "{} has no column `{name}`; its columns: {}",
+                    path.display(),
+                    headers.iter().collect::<Vec<_>>().join(", ")
+                ),
+            )
+        })
+    };
+    let (ix, iy) = (col("x", &r.x)?, col("y", &r.y)?);
+    let (mut x, mut y) = (Vec::new(), Vec::new());
+    for (i, rec) in rd.records().enumerate() {
+        let row = i + 2; // the header is line 1
+        let rec = rec
+            .map_err(|e| loc.err(span.clone(), &format!("{key}.file"), format!("{}: {e}", path.display())))?;
+        let num = |j: usize, name: &str| -> Result<f64, String> {
+            let s = rec.get(j).unwrap_or("").trim();
+            s.parse::<f64>().map_err(|_| {
+                loc.err(
+                    span.clone(),
+                    &format!("{key}.file"),
+                    format!("{}:{row}: column `{name}`: `{s}` is not a number", path.display()),
+                )
+            })
+        };
+        x.push(num(ix, &r.x)?);
+        y.push(num(iy, &r.y)?);
+    }
+    if x.is_empty() {
+        return Err(loc.err(span, &format!("{key}.file"), format!("{}: no rows", path.display())));
+    }
+    Ok(Reference {
+        label: r.label.clone().unwrap_or_else(|| r.file.trim_end_matches(".csv").to_string()),
+        path,
+        x_column: r.x.clone(),
+        y_column: r.y.clone(),
+        x,
+        y,
     })
 }
 
@@ -914,5 +1081,90 @@ max = 1.0
             GOOD.replace("[[figures]]", "[[cases]]\nname = \"sun-nx12\"\nparams = { re = 5 }\n[[figures]]");
         let e = p(&dup).unwrap_err();
         assert!(e.contains("sun-nx12") && e.contains("two cases"), "{e}");
+    }
+
+    /// A profile figure appended to [`GOOD`], with a reference file in
+    /// `ROOT/reference_data/ref.csv` (the problem is `ROOT/problems/x.toml`).
+    const PROFILE: &str = r#"
+[[figures]]
+id = "prof"
+kind = "profile"
+title = "u on x = 0.5"
+where = { pst = "sun" }
+file = "centerline_u.csv"
+x = "u"
+y = "y"
+x_label = "u / U (-)"
+label = ["nx"]
+reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982" }
+"#;
+
+    fn with_reference(csv: &str) -> tempfile::TempDir {
+        let root = tempfile::tempdir().unwrap();
+        std::fs::create_dir_all(root.path().join("reference_data")).unwrap();
+        std::fs::write(root.path().join("reference_data/ref.csv"), csv).unwrap();
+        root
+    }
+
+    fn p_in(root: &Path, src: &str) -> Result<Problem, String> {
+        parse(&root.join("problems/x.toml"), src, "quick")
+    }
+
+    #[test]
+    fn profile_reads_its_reference_points() {
+        let root = with_reference("y,Re100,Re400\n0.0,0.0,0.0\n0.5,-0.2,-0.1\n1.0,1.0,1.0\n");
+        let pr = p_in(root.path(), &format!("{GOOD}{PROFILE}")).unwrap();
+        let f = pr.figures.iter().find(|f| f.id == "prof").unwrap();
+        let FigureKind::Profile { file, x, y, reference: Some(r) } = &f.kind else { panic!("{:?}", f.kind) };
+        assert_eq!((file.as_str(), x.as_str(), y.as_str()), ("centerline_u.csv", "u", "y"));
+        assert_eq!(r.x, [0.0, -0.2, 1.0]);
+        assert_eq!(r.y, [0.0, 0.5, 1.0]);
+        assert_eq!(r.label, "Ghia et al. 1982");
+        assert_eq!(r.path, root.path().join("reference_data/ref.csv"));
+        assert_eq!(f.x_label.as_deref(), Some("u / U (-)"));
+        // Without a reference, and with the default label (the file stem).
+        let bare = PROFILE.replace(", label = \"Ghia et al. 1982\"", "");
+        let pr = p_in(root.path(), &format!("{GOOD}{bare}")).unwrap();
+        let FigureKind::Profile { reference: Some(r), .. } = &pr.figures[1].kind else { panic!() };
+        assert_eq!(r.label, "ref");
+        let none = bare.lines().filter(|l| !l.starts_with("reference")).collect::<Vec<_>>().join("\n");
+        let pr = p_in(root.path(), &format!("{GOOD}{none}")).unwrap();
+        assert!(matches!(pr.figures[1].kind, FigureKind::Profile { reference: None, .. }));
+        // reference_data/ sits next to the problems folder.
+        assert_eq!(reference_dir(Path::new("problems/a.toml")), Path::new("reference_data"));
+        assert_eq!(reference_dir(Path::new("/r/problems/a.toml")), Path::new("/r/reference_data"));
+    }
+
+    #[test]
+    fn profile_errors_name_file_line_and_key() {
+        let root = with_reference("y,Re100\n0.0,0.0\n1.0,1.0\n");
+        let src = format!("{GOOD}{PROFILE}");
+        let line = src.lines().position(|l| l.starts_with("reference =")).unwrap() + 1;
+        let at = format!("x.toml:{line}: ");
+        let e = p_in(root.path(), &src.replace("\"Re100\"", "\"Re1000\"")).unwrap_err();
+        assert!(
+            e.contains(&at) && e.contains("`figures.prof.reference.x`") && e.contains("no column `Re1000`"),
+            "{e}"
+        );
+        let e = p_in(root.path(), &src.replace("y = \"y\", label", "y = \"z\", label")).unwrap_err();
+        assert!(e.contains(&at) && e.contains("`figures.prof.reference.y`") && e.contains("`z`"), "{e}");
+        let e = p_in(root.path(), &src.replace("\"ref.csv\"", "\"nope.csv\"")).unwrap_err();
+        assert!(
+            e.contains(&at) && e.contains("`figures.prof.reference.file`") && e.contains("nope.csv"),
+            "{e}"
+        );
+        let e = p_in(root.path(), &src.replace("\"ref.csv\"", "\"../ref.csv\"")).unwrap_err();
+        assert!(e.contains("reference.file") && e.contains("file name"), "{e}");
+        let e = p_in(root.path(), &src.replace("Ghia et al. 1982\" }", "G\", colour = 1 }")).unwrap_err();
+        assert!(e.contains("colour"), "{e}");
+        let bad = with_reference("y,Re100\n0.0,0.0\n0.5,oops\n");
+        let e = p_in(bad.path(), &src).unwrap_err();
+        assert!(e.contains(&at) && e.contains("ref.csv:3") && e.contains("`oops`"), "{e}");
+        let e = p_in(root.path(), &src.replace("file = \"centerline_u.csv\"\n", "")).unwrap_err();
+        assert!(e.contains("`figures.prof`") && e.contains("needs `file`"), "{e}");
+        let e = p_in(root.path(), &src.replace("y = \"y\"\nx_label", "x_label")).unwrap_err();
+        assert!(e.contains("needs `y`"), "{e}");
+        let e = p_in(root.path(), &src.replace("kind = \"profile\"", "kind = \"timeseries\"")).unwrap_err();
+        assert!(e.contains("only kind `profile`"), "{e}");
     }
 }

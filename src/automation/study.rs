@@ -68,7 +68,11 @@ fn fmt(x: f64) -> String {
 
 /// Reads columns `t` and `y` of a case's `timeseries.csv`.
 fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let path = dir.join("timeseries.csv");
+    columns(&dir.join("timeseries.csv"), "t", y)
+}
+
+/// Reads columns `x` and `y` of a CSV file (unparsable values are NaN).
+fn columns(path: &Path, x: &str, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     let mut rd = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let headers = rd.headers().map_err(|e| format!("{}: {e}", path.display()))?.clone();
     let col = |name: &str| {
@@ -80,7 +84,7 @@ fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
             )
         })
     };
-    let (it, iy) = (col("t")?, col(y)?);
+    let (it, iy) = (col(x)?, col(y)?);
     let (mut t, mut v) = (Vec::new(), Vec::new());
     for rec in rd.records() {
         let rec = rec.map_err(|e| format!("{}: {e}", path.display()))?;
@@ -296,7 +300,7 @@ fn figure(
                     x,
                     y,
                     value: v,
-                    value_label: format!("{field} (Pa)"),
+                    value_label: with_unit(field),
                     range: None,
                     aspect_equal: true,
                 },
@@ -314,9 +318,47 @@ fn figure(
                 ),
             )])
         }
+        FigureKind::Profile { file, x, y, reference } => {
+            let mut series = Vec::new();
+            for r in rs.iter().filter(|r| r.summary.is_some() && r.entry.dir.join(file).exists()) {
+                let (a, b) = columns(&r.entry.dir.join(file), x, y)?;
+                series.push(Series { label: label(r.case, &f.label), x: a, y: b, style: SeriesStyle::Line });
+            }
+            if let Some(rf) = reference {
+                series.push(Series {
+                    label: rf.label.clone(),
+                    x: rf.x.clone(),
+                    y: rf.y.clone(),
+                    style: SeriesStyle::Reference,
+                });
+            }
+            report::line_figure(
+                &report::LineFigure {
+                    title: f.title.clone(),
+                    x_label: f.x_label.clone().unwrap_or_else(|| x.clone()),
+                    y_label: f.y_label.clone().unwrap_or_else(|| y.clone()),
+                    log_x: false,
+                    log_y: f.log_y,
+                    series,
+                },
+                &stem,
+            )?;
+            Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
+        }
         FigureKind::Trade { x } => trade(f, &rs, x, figures, tables, &caption),
         FigureKind::Stability { x, max } => stability(f, &rs, x, *max, figures, tables, &caption),
     }
+}
+
+/// A point array's name with its unit, for a colour bar.
+fn with_unit(field: &str) -> String {
+    let unit = match field {
+        "pressure" | "pressure_deviation" | "pressure_exact" => " (Pa)",
+        "speed" | "velocity" => " (m/s)",
+        "density" => " (kg/m^3)",
+        _ => "",
+    };
+    format!("{field}{unit}")
 }
 
 /// Error against wall time and against particle-steps, the Pareto front, and a table
@@ -568,4 +610,95 @@ fn metrics_table(p: &Problem, t: &Table, output: &Path, tables: &Path) -> Result
         md_path: format!("tables/{}.md", t.id),
         caption: if t.caption.is_empty() { t.title.clone() } else { t.caption.clone() },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::automation::registry;
+    use crate::automation::report::testutil::check_figure;
+    use crate::solver::output::summary::Provenance;
+
+    const SRC: &str = r#"
+title = "t"
+scene = "taylor_green"
+[presets.quick]
+nx = [12, 16]
+[[cases]]
+name = "nx{nx}"
+grid = { nx = "$nx" }
+[[figures]]
+id = "prof_u"
+kind = "profile"
+title = "u on x = 0.5"
+file = "centerline_u.csv"
+x = "u"
+y = "y"
+x_label = "u / U (-)"
+y_label = "y / L (-)"
+label = ["nx"]
+metric = "l1_velocity_final"
+converges = true
+reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982" }
+caption = "u profiles"
+paper = "Fig. 14a"
+"#;
+
+    /// A profile figure: one curve per case that has a result and the file, the
+    /// reference drawn as points, the manuscript line with the metric and the claim.
+    #[test]
+    fn profile_figure_from_case_files_and_reference() {
+        let root = tempfile::tempdir().unwrap();
+        let root = root.path();
+        std::fs::create_dir_all(root.join("reference_data")).unwrap();
+        std::fs::write(root.join("reference_data/ref.csv"), "y,Re100\n0.0,0.0\n0.5,-0.2\n1.0,1.0\n").unwrap();
+        let p = registry::parse(&root.join("problems/cav.toml"), SRC, "quick").unwrap();
+        let output = root.join("output");
+        for (c, err) in p.cases.iter().zip([0.2, 0.1]) {
+            let e = Entry::new(&output, &p, c);
+            std::fs::create_dir_all(&e.dir).unwrap();
+            let ys: Vec<f64> = (0..=10).map(|i| i as f64 / 10.0).collect();
+            let mut csv = String::from("y,u\n");
+            for y in &ys {
+                csv += &format!("{y},{}\n", y * y - 0.3 * y + err);
+            }
+            std::fs::write(e.dir.join("centerline_u.csv"), csv).unwrap();
+            Summary {
+                scene: "taylor_green".into(),
+                params: c.params.to_json(),
+                particles: 144,
+                steps: 10,
+                final_time: 1.0,
+                wall_seconds: 0.1,
+                particle_steps_per_second: 1.0,
+                threads: 1,
+                status: Status::Completed,
+                reason: None,
+                step: None,
+                metrics: [("l1_velocity_final".to_string(), err)].into(),
+                provenance: Provenance::now(chrono::Utc::now()),
+            }
+            .write(&e.dir)
+            .unwrap();
+        }
+        let manuscript = root.join("manuscript");
+        let section = regenerate(&p, &output, &manuscript).unwrap();
+        check_figure(
+            &manuscript.join("figures/prof_u"),
+            (900, 600),
+            &["u on x = 0.5", "nx = 12", "nx = 16", "Ghia et al. 1982", "u / U (-)", "y / L (-)"],
+        );
+        let Item::Figure { ours, paper, .. } = &section.items[0] else { panic!() };
+        assert_eq!(paper, "Fig. 14a");
+        assert!(ours.contains("nx = 12: 2.000e-1") && ours.contains("Reproduced"), "{ours}");
+
+        // A case without its file is left out of the figure and reported as missing.
+        let e = Entry::new(&output, &p, &p.cases[1]);
+        std::fs::remove_file(e.dir.join("summary.json")).unwrap();
+        let section = regenerate(&p, &output, &manuscript).unwrap();
+        let svg = std::fs::read_to_string(manuscript.join("figures/prof_u.svg")).unwrap();
+        assert!(!svg.contains("nx = 16"));
+        let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
+        assert!(ours.contains("No result for: nx16"), "{ours}");
+    }
 }

@@ -84,6 +84,8 @@ impl Axis {
     /// Tick label for the value `v`.
     pub(crate) fn format(&self, v: f64) -> String {
         match self {
+            // A tick computed as lo + k * step can miss zero by rounding (-5.551e-17).
+            Axis::Linear(lo, hi) if v.abs() < 1e-9 * (hi - lo).abs() => fmt_num(0.0),
             Axis::Linear(..) => fmt_num(v),
             Axis::Log(..) => fmt_log(v),
             Axis::Category(names) => {
@@ -228,10 +230,19 @@ pub(crate) fn chart<DB: DrawingBackend>(
     x: Axis,
     y: Axis,
 ) -> Result<Chart<'_, DB>, String> {
+    // Category names (e.g. `ctvf/ipst/none`) need more room than numbers: about 0.6 em
+    // per character, plus the axis description.
+    let y_area = match &y {
+        Axis::Category(names) => {
+            let chars = names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as u32;
+            Y_LABEL_AREA.max(chars * TICK_SIZE * 6 / 10 + DESC_SIZE + 25)
+        }
+        _ => Y_LABEL_AREA,
+    };
     ChartBuilder::on(area)
         .margin(MARGIN)
         .x_label_area_size(X_LABEL_AREA)
-        .y_label_area_size(Y_LABEL_AREA)
+        .y_label_area_size(y_area)
         .build_cartesian_2d(x, y)
         .map_err(|e| e.to_string())
 }
@@ -373,6 +384,8 @@ mod tests {
         assert_eq!(fmt_log(0.01), "0.01");
         assert_eq!(fmt_log(100.0), "100");
         assert_eq!(fmt_log(2e-4), "2e-4");
+        assert_eq!(Axis::Linear(-0.45, 1.05).format(-5.551115123125783e-17), "0");
+        assert_eq!(Axis::Linear(-1e-12, 1e-12).format(1e-13), "1e-13");
     }
 
     #[test]

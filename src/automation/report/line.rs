@@ -32,6 +32,8 @@ pub enum SeriesStyle {
     Points,
     /// Solid line with markers at the data points.
     LinePoints,
+    /// Black square markers: published reference points.
+    Reference,
 }
 
 /// A figure of curves y(x).
@@ -99,32 +101,35 @@ impl Render for LineFigure {
         let mut colour_index = 0;
         for (s, runs) in self.series.iter().zip(&runs) {
             let dashed = s.style == SeriesStyle::Dashed;
-            let color = if dashed {
+            let reference = s.style == SeriesStyle::Reference;
+            let color = if dashed || reference {
                 REFERENCE
             } else {
                 colour_index += 1;
                 palette(colour_index - 1)
             };
             let line = color.stroke_width(if dashed { 2 } else { 3 });
-            let with_line = s.style != SeriesStyle::Points;
-            let with_marks = matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints);
+            let with_line = !matches!(s.style, SeriesStyle::Points | SeriesStyle::Reference);
+            let with_marks =
+                matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints | SeriesStyle::Reference);
+            let mark = if reference { 2 } else { 0 };
             for (k, run) in runs.iter().enumerate() {
                 let anno = if dashed {
                     chart.draw_series(DashedLineSeries::new(run.iter().copied(), 10, 6, line))
                 } else if with_line {
                     chart.draw_series(LineSeries::new(run.iter().copied(), line))
                 } else {
-                    chart.draw_series(run.iter().map(|&p| Glyph::marker(0, p, 4, color.filled())))
+                    chart.draw_series(run.iter().map(|&p| Glyph::marker(mark, p, 4, color.filled())))
                 }
                 .map_err(|e| e.to_string())?;
                 if k == 0 {
                     let sample_line = with_line.then_some((line, dashed));
-                    let sample_mark = with_marks.then_some((0, 4, color.filled()));
+                    let sample_mark = with_marks.then_some((mark, 4, color.filled()));
                     anno.label(s.label.clone()).legend(move |p| Glyph::sample(p, sample_line, sample_mark));
                 }
                 if with_marks && with_line {
                     chart
-                        .draw_series(run.iter().map(|&p| Glyph::marker(0, p, 4, color.filled())))
+                        .draw_series(run.iter().map(|&p| Glyph::marker(mark, p, 4, color.filled())))
                         .map_err(|e| e.to_string())?;
                 }
             }
