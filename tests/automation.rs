@@ -35,13 +35,15 @@ impl Env {
     fn run(&self, args: &[&str]) -> Output {
         self.cmd(args).output().unwrap()
     }
+    /// The folder of case `name`; after an edit there are two (the stale one is kept), so
+    /// the one written last.
     fn case_dir(&self, name: &str) -> PathBuf {
         let dir = self.root.join("output/tiny");
         std::fs::read_dir(&dir)
             .unwrap()
             .flatten()
             .map(|e| e.path())
-            .find(|p| {
+            .filter(|p| {
                 p.is_dir()
                     && p.file_name()
                         .unwrap()
@@ -49,8 +51,10 @@ impl Env {
                         .rsplit_once('-')
                         .is_some_and(|(n, _)| n == name)
             })
+            .max_by_key(|p| std::fs::metadata(p.join("case.json")).and_then(|m| m.modified()).ok())
             .unwrap_or_else(|| panic!("no folder for case {name}"))
     }
+
     fn summary(&self, name: &str) -> serde_json::Value {
         let s = std::fs::read_to_string(self.case_dir(name).join("summary.json")).unwrap();
         serde_json::from_str(&s).unwrap()

@@ -39,7 +39,7 @@ pub struct Provenance {
 
 /// Bumped whenever the solver's results change for unchanged parameters; part of every
 /// cache key (with the crate version).
-pub const SCHEME_VERSION: &str = "1";
+pub const SCHEME_VERSION: &str = "2";
 
 impl Provenance {
     /// Provenance of this binary, for a run that started at `started`.
