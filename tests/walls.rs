@@ -1,0 +1,50 @@
+//! Walls (Adami et al. 2012, CTVF sec. 3.6): fluid at rest in a tank stays inside with the
+//! hydrostatic pressure; the lid-driven cavity at Re = 100 approaches Ghia's profiles.
+//! Bounds are the quick-preset values measured on this code (stated), plus 30 %.
+
+use sphrepro::scenes::harness::{self, RunOptions};
+use sphrepro::scenes::{cavity, hydrostatic_tank, SceneEntry};
+use std::collections::BTreeMap;
+
+fn run(entry: &SceneEntry, sets: &[&str]) -> BTreeMap<String, f64> {
+    let dir = tempfile::tempdir().unwrap();
+    let params = entry.params_from_sets(&sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap();
+    let s =
+        harness::run(entry, &params, dir.path(), &RunOptions { quiet: true, ..Default::default() }).unwrap();
+    assert_eq!(serde_json::to_value(s.status).unwrap(), "completed", "{sets:?}");
+    s.metrics
+}
+
+#[test]
+fn a_tank_at_rest_keeps_its_fluid_and_its_hydrostatic_pressure() {
+    let m = run(&hydrostatic_tank::ENTRY, &["dx=0.05", "tf=1.0", "alpha=0.05"]);
+    assert_eq!(m["particles_outside"], 0.0, "fluid crossed a wall");
+    // measured: 2.58e-3 of rho g H, and 6.3e-4 sqrt(g H)
+    assert!(m["pressure_rel_error"] < 0.0034, "{m:?}");
+    assert!(m["max_speed"] < 0.00082, "{m:?}");
+}
+
+#[test]
+fn the_cavity_at_re_100_approaches_ghia() {
+    let m = run(&cavity::ENTRY, &["nx=30", "re=100", "tf=5.0", "pst=sun"]);
+    // measured: ghia_u_rms 2.28e-2, ghia_v_rms 1.51e-2 (units of the lid speed)
+    assert!(m["ghia_u_rms"] < 0.030, "{m:?}");
+    assert!(m["ghia_v_rms"] < 0.020, "{m:?}");
+}
+
+#[test]
+fn bad_geometry_is_refused_naming_the_parameter() {
+    for (entry, sets, key) in [
+        (&hydrostatic_tank::ENTRY, &["dx=0.5"][..], "height"),
+        (&hydrostatic_tank::ENTRY, &["dx=-0.1"][..], "dx"),
+        (&hydrostatic_tank::ENTRY, &["pst=sun"][..], "pst"),
+        (&cavity::ENTRY, &["hdx=1.5"][..], "hdx"),
+    ] {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let err = match entry.params_from_sets(&sets) {
+            Err(e) => e,
+            Ok(p) => (entry.build)(&p).err().expect("refused"),
+        };
+        assert!(err.contains(key), "{sets:?}: {err}");
+    }
+}
