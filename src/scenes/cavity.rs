@@ -11,7 +11,9 @@
 //! interpolations of the fluid particles. Files: `centerline_u.csv` (y, u) and
 //! `centerline_v.csv` (x, v), 101 points each.
 
-use super::common::{fluid_scheme, scheme_params, shepard, write_fluid, write_wall, FluidConstants};
+use super::common::{
+    fluid_scheme, particle_count, restore_sim, scheme_params, shepard, snapshot_bodies, FluidConstants,
+};
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -178,7 +180,7 @@ impl Cavity {
 
 impl SceneRun for Cavity {
     fn particles(&self) -> usize {
-        self.sim.fluid().len() + self.sim.walls.as_ref().map_or(0, |w| w.wall.len())
+        particle_count(&self.sim)
     }
     fn time(&self) -> f64 {
         self.sim.time()
@@ -209,14 +211,7 @@ impl SceneRun for Cavity {
         vec![("t", self.sim.time()), ("kinetic_energy", ke), ("u_max", self.sim.max_speed())]
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
-        let name = format!("fluid_{index:05}.vtu");
-        write_fluid(&dir.join(&name), self.sim.fluid(), Vec::new())?;
-        let mut files = vec![("fluid".to_string(), name)];
-        if let Some(ws) = &self.sim.walls {
-            let name = format!("wall_{index:05}.vtu");
-            write_wall(&dir.join(&name), &ws.wall)?;
-            files.push(("wall".into(), name));
-        }
+        let files = snapshot_bodies(&self.sim, dir, index, Vec::new())?;
         // The centre-line profiles of the latest state (the case folder is the parent).
         if let Some(case) = dir.parent() {
             self.write_profile(&case.join("centerline_u.csv"), true)?;
@@ -247,11 +242,9 @@ impl SceneRun for Cavity {
         serde_json::json!({ "sim": &self.sim.state, "energy": &self.energy })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
         self.energy =
             serde_json::from_value(state["energy"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        self.sim.restore(sim);
-        Ok(())
+        restore_sim(&mut self.sim, &state)
     }
 }
 

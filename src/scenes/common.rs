@@ -7,6 +7,7 @@ use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
 use crate::solver::particles::{Fluid, Wall};
 use crate::solver::scheme::{Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName};
+use crate::solver::simulation::Simulation;
 use std::path::Path;
 
 const SWITCH: &[&str] = &["auto", "on", "off"];
@@ -156,4 +157,34 @@ pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize
         }
     }
     (den > 0.0).then(|| num / den)
+}
+
+/// Particles in every body of `sim`.
+pub fn particle_count(sim: &Simulation<2>) -> usize {
+    sim.fluid().len() + sim.walls.as_ref().map_or(0, |w| w.wall.len())
+}
+
+/// Writes the snapshots of every body of `sim` (the fluid with `extra` fields) for output
+/// number `index`; returns the (body, file) pairs.
+pub fn snapshot_bodies(
+    sim: &Simulation<2>,
+    dir: &Path,
+    index: usize,
+    extra: Vec<Field>,
+) -> std::io::Result<Vec<(String, String)>> {
+    let name = format!("fluid_{index:05}.vtu");
+    write_fluid(&dir.join(&name), sim.fluid(), extra)?;
+    let mut files = vec![("fluid".to_string(), name)];
+    if let Some(ws) = &sim.walls {
+        let name = format!("wall_{index:05}.vtu");
+        write_wall(&dir.join(&name), &ws.wall)?;
+        files.push(("wall".into(), name));
+    }
+    Ok(files)
+}
+
+/// Restores `sim` from the `sim` entry of a scene's checkpoint.
+pub fn restore_sim(sim: &mut Simulation<2>, state: &serde_json::Value) -> Result<(), String> {
+    sim.restore(serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?);
+    Ok(())
 }

@@ -9,7 +9,9 @@
 //! (none may be). The free surface is not treated (CTVF sec. 3.4-3.5 is not implemented yet),
 //! so the scene runs without particle shifting (`scheme = ctvf`, `pst = none`).
 
-use super::common::{fluid_scheme, scheme_params, write_fluid, write_wall, FluidConstants};
+use super::common::{
+    fluid_scheme, particle_count, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+};
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -132,7 +134,7 @@ impl Tank {
 
 impl SceneRun for Tank {
     fn particles(&self) -> usize {
-        self.sim.fluid().len() + self.sim.walls.as_ref().map_or(0, |w| w.wall.len())
+        particle_count(&self.sim)
     }
     fn time(&self) -> f64 {
         self.sim.time()
@@ -162,15 +164,7 @@ impl SceneRun for Tank {
         vec![("t", self.sim.time()), ("max_speed", umax), ("pressure_rel_error", p_err)]
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
-        let name = format!("fluid_{index:05}.vtu");
-        write_fluid(&dir.join(&name), self.sim.fluid(), Vec::new())?;
-        let mut files = vec![("fluid".to_string(), name)];
-        if let Some(ws) = &self.sim.walls {
-            let name = format!("wall_{index:05}.vtu");
-            write_wall(&dir.join(&name), &ws.wall)?;
-            files.push(("wall".into(), name));
-        }
-        Ok(files)
+        snapshot_bodies(&self.sim, dir, index, Vec::new())
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
         let (p_err, umax) = self.errors();
@@ -186,8 +180,6 @@ impl SceneRun for Tank {
         serde_json::json!({ "sim": &self.sim.state })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        self.sim.restore(sim);
-        Ok(())
+        restore_sim(&mut self.sim, &state)
     }
 }

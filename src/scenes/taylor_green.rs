@@ -13,7 +13,7 @@
 //! - `p_l1_final`: mean |(p - mean p) - (p_e - mean p_e)| over max |p_e| at tf;
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
-use super::common::{fluid_scheme, scheme_params, write_fluid, FluidConstants};
+use super::common::{fluid_scheme, restore_sim, scheme_params, snapshot_bodies, FluidConstants};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
@@ -222,10 +222,8 @@ impl SceneRun for TaylorGreen {
         serde_json::json!({ "sim": &self.sim.state, "l1_max": self.l1_max })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let sim = serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
         self.l1_max = state["l1_max"].as_f64().ok_or("checkpoint: no l1_max")?;
-        self.sim.restore(sim);
-        Ok(())
+        restore_sim(&mut self.sim, &state)
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let e = self.errors();
@@ -251,13 +249,12 @@ impl SceneRun for TaylorGreen {
         // differences act); the deviation from the mean is the field to look at.
         let p_mean = f.p.iter().sum::<f64>() / f.len() as f64;
         let p_dev: Vec<f64> = f.p.iter().map(|p| p - p_mean).collect();
-        let name = format!("fluid_{index:05}.vtu");
-        write_fluid(
-            &dir.join(&name),
-            f,
+        snapshot_bodies(
+            &self.sim,
+            dir,
+            index,
             vec![Field::Scalar("pressure_deviation", p_dev), Field::Scalar("pressure_exact", p_exact)],
-        )?;
-        Ok(vec![("fluid".into(), name)])
+        )
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
         let e = self.errors();
