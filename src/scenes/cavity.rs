@@ -94,6 +94,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         density: DensityModel::Summation,
         gravity: [0.0; 3],
         internal_flow: true,
+        free_surface: false,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {

@@ -77,6 +77,8 @@ pub struct FluidConstants {
     pub gravity: [f64; 3],
     /// No free surface (the pressure level is arbitrary).
     pub internal_flow: bool,
+    /// A free surface to detect and keep the shifting tangential to.
+    pub free_surface: bool,
 }
 
 /// The kernel, smoothing length and scheme the parameters ask for.
@@ -105,6 +107,7 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
         ipst_max_iter: p.int("ipst_max_iter") as usize,
         gravity: c.gravity,
         internal_flow: c.internal_flow,
+        free_surface: c.free_surface,
     };
     let scheme = SchemeName::from_name(p.str("scheme")).expect("checked choice").fluid_scheme(&settings);
     (kernel, h, scheme)

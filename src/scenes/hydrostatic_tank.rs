@@ -82,6 +82,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         density: DensityModel::Continuity,
         gravity: [0.0, -G, 0.0],
         internal_flow: false,
+        free_surface: true,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {

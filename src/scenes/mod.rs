@@ -5,6 +5,7 @@
 
 pub mod cavity;
 pub mod common;
+pub mod free_surface_demo;
 pub mod geometry;
 pub mod harness;
 pub mod hydrostatic_tank;
@@ -68,7 +69,8 @@ pub struct SceneEntry {
 }
 
 /// Every scene.
-pub const SCENES: &[SceneEntry] = &[taylor_green::ENTRY, cavity::ENTRY, hydrostatic_tank::ENTRY];
+pub const SCENES: &[SceneEntry] =
+    &[taylor_green::ENTRY, cavity::ENTRY, hydrostatic_tank::ENTRY, free_surface_demo::ENTRY];
 
 /// Looks a scene up by name.
 pub fn find(name: &str) -> Result<&'static SceneEntry, String> {

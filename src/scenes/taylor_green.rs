@@ -97,6 +97,7 @@ pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
         density: DensityModel::Summation,
         gravity: [0.0; 3],
         internal_flow: true,
+        free_surface: false,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
 

@@ -5,7 +5,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
-use crate::solver::scheme::{
+use crate::solver::scheme::{SurfaceFields, 
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
     Shifting, WallSet,
 };
@@ -107,6 +107,9 @@ pub struct Simulation<const D: usize> {
     pub state: State<D>,
     /// The walls, if the scene has any: not integrated, so not part of the state.
     pub walls: Option<WallSet<D>>,
+    /// Free-surface particles and normals, when the scheme declares a free surface
+    /// (recomputed every step before the accelerations).
+    pub surface: Option<SurfaceFields<D>>,
     cells: CellList<D>,
     neighbours: KernelList<D>,
     passes: FluidPasses<D>,
@@ -149,6 +152,7 @@ impl<const D: usize> Simulation<D> {
             time_settings,
             state,
             walls: wall.map(|w| WallSet::new(w, domain, radius)),
+            surface: scheme.free_surface.map(|_| SurfaceFields::default()),
             cells: CellList::new(domain, radius),
             neighbours: KernelList::new(),
             passes: FluidPasses::new(),
@@ -259,12 +263,17 @@ impl<const D: usize> Simulation<D> {
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
         let (st, walls) = (&mut self.state, self.walls.as_ref());
-        self.passes.accelerations(&st.fluid, &self.neighbours, walls, &st.scheme, &mut st.rates, dt_nominal);
+        if let (Some(fs), Some(rho0)) = (self.surface.as_mut(), st.scheme.free_surface) {
+            fs.detect(&st.fluid, &self.neighbours, walls, rho0);
+        }
+        let surface = self.surface.as_ref();
+        self.passes.accelerations(&st.fluid, &self.neighbours, walls, surface, &st.scheme, &mut st.rates, dt_nominal);
         let clock = lap(clock, &mut self.times.accelerations);
         st.ipst_iterations = self.passes.ipst(
             &st.fluid,
             &self.neighbours,
             walls,
+            surface,
             &self.kernel,
             &st.scheme,
             &mut st.rates,

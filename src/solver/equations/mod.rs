@@ -9,6 +9,7 @@
 pub mod artificial_viscosity;
 pub mod continuity;
 pub mod edac;
+pub mod free_surface;
 pub mod momentum;
 pub mod shifting;
 pub mod viscosity;

@@ -6,10 +6,12 @@
 //! the [`Corrections`] field. [`Display`](std::fmt::Display) prints the plan, written at the
 //! top of every run log.
 
+mod free_surface;
 mod passes;
 mod walls;
 
 pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
+pub use free_surface::SurfaceFields;
 pub use walls::WallSet;
 
 use serde::{Deserialize, Serialize};
@@ -197,6 +199,9 @@ pub struct FluidScheme {
     pub transport: Option<Transport>,
     /// Body force per unit mass (x, y, z; the first D components are used).
     pub gravity: [f64; 3],
+    /// A free surface, detected every step (sec. 3.4), with the fluid's reference density
+    /// for the low-density rule; the shifting is then kept tangential near it (sec. 3.5).
+    pub free_surface: Option<f64>,
 }
 
 /// What a scene gives a scheme name to build a [`FluidScheme`] from.
@@ -233,6 +238,8 @@ pub struct FluidSettings {
     /// An internal flow (no free surface): the pressure level is arbitrary, so the
     /// pressure gradient uses the local mean-pressure correction (BQL).
     pub internal_flow: bool,
+    /// A free surface to detect (sec. 3.4-3.5).
+    pub free_surface: bool,
 }
 
 impl SchemeName {
@@ -261,6 +268,7 @@ impl SchemeName {
                 artificial_viscosity,
                 transport: Some(background(2.0)),
                 gravity: s.gravity,
+                free_surface: None,
             },
             SchemeName::Tvf => FluidScheme {
                 name: self,
@@ -271,6 +279,7 @@ impl SchemeName {
                 artificial_viscosity,
                 transport: Some(background(1.0)),
                 gravity: s.gravity,
+                free_surface: None,
             },
             SchemeName::Ctvf => {
                 let shifting = match s.pst {
@@ -292,6 +301,7 @@ impl SchemeName {
                     artificial_viscosity,
                     transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
                     gravity: s.gravity,
+                    free_surface: s.free_surface.then_some(s.rho0),
                 }
             }
         }
@@ -361,6 +371,9 @@ impl fmt::Display for FluidScheme {
         let g = self.gravity;
         if g.iter().any(|&v| v != 0.0) {
             writeln!(f, "  gravity      {g:?}")?;
+        }
+        if self.free_surface.is_some() {
+            writeln!(f, "  surface      detected every step (sec. 3.4); shifting tangential near it (eqs. 44-45)")?;
         }
         Ok(())
     }

@@ -3,9 +3,9 @@
 //! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
 //! for any number of threads.
 
-use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, WallSet};
+use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, SurfaceFields, WallSet};
 use crate::solver::equations::{
-    artificial_viscosity, continuity, edac, momentum, shifting, viscosity, Pair, Point,
+    artificial_viscosity, continuity, edac, free_surface, momentum, shifting, viscosity, Pair, Point,
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
@@ -241,11 +241,13 @@ impl<const D: usize> FluidPasses<D> {
     /// Walls act through their pressure (pressure gradient), their no-slip ghost velocity
     /// (viscosity) and as neighbours in the shifting; the transport-velocity terms
     /// (artificial stress, momentum correction) sum over the fluid only.
+    #[allow(clippy::too_many_arguments)]
     pub fn accelerations(
         &mut self,
         fluid: &Fluid<D>,
         nl: &KernelList<D>,
         walls: Option<&WallSet<D>>,
+        surface: Option<&SurfaceFields<D>>,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
@@ -313,6 +315,10 @@ impl<const D: usize> FluidPasses<D> {
             if matches!(shifting, Some(Shifting::Sun2019 { .. })) {
                 ac *= sun_prefactor;
             }
+            if let Some(fs) = surface {
+                // eq. (44)
+                ac = free_surface::adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
+            }
             (acc + g, ac)
         };
         let ipst = matches!(shifting, Some(Shifting::Ipst { .. }));
@@ -347,6 +353,7 @@ impl<const D: usize> FluidPasses<D> {
         fluid: &Fluid<D>,
         nl: &KernelList<D>,
         walls: Option<&WallSet<D>>,
+        surface: Option<&SurfaceFields<D>>,
         k: &Kernel,
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
@@ -380,6 +387,10 @@ impl<const D: usize> FluidPasses<D> {
                         });
                     }
                     *dr = d * (u_max * dt);
+                    if let Some(fs) = surface {
+                        // eq. (45)
+                        *dr = free_surface::adjust_shift(*dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                    }
                     *chi = x;
                 },
             );

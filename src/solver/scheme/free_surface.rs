@@ -1,0 +1,102 @@
+//! Free-surface detection (CTVF sec. 3.4 and Algorithm 1): normals, surface particles and
+//! the particles next to them, recomputed every step for fluids that declare a free surface.
+
+use super::passes::KernelList;
+use super::WallSet;
+use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal, smoothed_normal};
+use crate::solver::equations::{Pair, Point};
+use crate::solver::math::Vector;
+use crate::solver::particles::Fluid;
+use rayon::prelude::*;
+
+/// Per-particle free-surface state of one fluid.
+#[derive(Clone, Debug, Default)]
+pub struct SurfaceFields<const D: usize> {
+    n_star: Vec<Vector<D>>,
+    /// Smoothed unit normal (eq. 43), zero inside the fluid.
+    pub normal: Vec<Vector<D>>,
+    /// Summation density `sum_b m_b W_ab` over fluid and walls (the low-density rule).
+    pub rho_sum: Vec<f64>,
+    /// On the free surface.
+    pub surface: Vec<bool>,
+    /// Not on it, but with a surface particle among its neighbours (h_b < h, Algorithm 1).
+    pub near: Vec<bool>,
+}
+
+fn fluid_point<const D: usize>(f: &Fluid<D>, j: usize) -> Point<D> {
+    Point::new(f.u[j], f.u[j], f.m[j], f.rho[j], f.p[j])
+}
+
+impl<const D: usize> SurfaceFields<D> {
+    /// Detects the surface of `fluid` (with walls as neighbours) whose reference density is
+    /// `rho0`: eq. (42) with its cut-off, eq. (43), the low-density rule (summation density
+    /// below rho0 / 2), the 60-degree test, and the neighbours of surface particles.
+    pub fn detect(&mut self, fluid: &Fluid<D>, nl: &KernelList<D>, walls: Option<&WallSet<D>>, rho0: f64) {
+        let (n, h, x) = (fluid.len(), fluid.h, &fluid.x);
+        self.n_star.resize(n, Vector::zeros());
+        self.normal.resize(n, Vector::zeros());
+        self.rho_sum.resize(n, 0.0);
+        self.surface.resize(n, false);
+        self.near.resize(n, false);
+        let wall_point = |ws: &WallSet<D>, j: usize| {
+            Point::new(Vector::<D>::zeros(), Vector::zeros(), ws.wall.m[j], ws.wall.rho(j), 0.0)
+        };
+        // Eq. (42) and the summation density, over the fluid and the walls.
+        self.n_star.par_iter_mut().zip(self.rho_sum.par_iter_mut()).enumerate().for_each(|(i, (ns, rs))| {
+            let (mut nv, mut r) = (Vector::<D>::zeros(), 0.0);
+            nl.for_each(i, x, |j, xij, r2, &(w, g)| {
+                nv += normal(&fluid_point(fluid, j), &Pair::new(xij, r2, h, w, g));
+                r += fluid.m[j] * w;
+            });
+            if let Some(ws) = walls {
+                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, xij, r2, &(w, g)| {
+                    nv += normal(&wall_point(ws, j), &Pair::new(xij, r2, h, w, g));
+                    r += ws.wall.m[j] * w;
+                });
+            }
+            *ns = cut_normal(nv, h);
+            *rs = r;
+        });
+        // Eq. (43): smoothed over the fluid, then normalised.
+        let n_star = &self.n_star;
+        self.normal.par_iter_mut().enumerate().for_each(|(i, out)| {
+            let mut nv = Vector::<D>::zeros();
+            nl.for_each(i, x, |j, xij, r2, &(w, g)| {
+                nv += smoothed_normal(&fluid_point(fluid, j), &n_star[j], &Pair::new(xij, r2, h, w, g));
+            });
+            let len = nv.norm();
+            *out = if len > 0.0 { nv / len } else { Vector::zeros() };
+        });
+        // Surface particles: isolated (low density), or with a normal and no neighbour in
+        // the 60-degree cone around it.
+        let (normals, rho_sum) = (&self.normal, &self.rho_sum);
+        self.surface.par_iter_mut().enumerate().for_each(|(i, out)| {
+            let na = normals[i];
+            if rho_sum[i] < 0.5 * rho0 {
+                *out = true;
+                return;
+            }
+            if na == Vector::<D>::zeros() {
+                *out = false;
+                return;
+            }
+            let mut covered = false;
+            nl.for_each(i, x, |_, xij, r2, &(w, g)| covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g)));
+            if let Some(ws) = walls {
+                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |_, xij, r2, &(w, g)| {
+                    covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g))
+                });
+            }
+            *out = !covered;
+        });
+        // Algorithm 1: the particles with a surface particle in their support.
+        let surface = &self.surface;
+        self.near.par_iter_mut().enumerate().for_each(|(i, out)| {
+            let mut near = false;
+            if !surface[i] {
+                nl.for_each(i, x, |j, _, _, _| near |= surface[j]);
+            }
+            *out = near;
+        });
+    }
+}
