@@ -5,6 +5,7 @@
 
 pub mod cavity;
 pub mod common;
+pub mod dam_break;
 pub mod free_surface_demo;
 pub mod geometry;
 pub mod harness;
@@ -70,7 +71,7 @@ pub struct SceneEntry {
 
 /// Every scene.
 pub const SCENES: &[SceneEntry] =
-    &[taylor_green::ENTRY, cavity::ENTRY, hydrostatic_tank::ENTRY, free_surface_demo::ENTRY];
+    &[taylor_green::ENTRY, cavity::ENTRY, dam_break::ENTRY, hydrostatic_tank::ENTRY, free_surface_demo::ENTRY];
 
 /// Looks a scene up by name.
 pub fn find(name: &str) -> Result<&'static SceneEntry, String> {
