@@ -1,9 +1,9 @@
 //! Every problem file in `problems/` validates (every preset, figures, tables, bounds and
 //! the reference data they draw against), against the registered scenes.
 //!
-//! Scenes not yet registered but whose contract is fixed (issue 5: `cavity` and
-//! `hydrostatic_tank`) are validated against stubs declaring that contract's parameters
-//! and metrics; once a scene is registered the stub is no longer used, so the real
+//! Scenes not yet registered but whose contract is fixed (issue 5: `cavity`,
+//! `hydrostatic_tank`, `dam_break` and `free_surface_demo`) are validated against stubs
+//! declaring that contract's parameters and metrics; once a scene is registered the stub is no longer used, so the real
 //! declaration is what the file is checked against. A problem naming any other unknown
 //! scene fails.
 
@@ -60,6 +60,35 @@ fn tank_params() -> Vec<Spec> {
     v
 }
 
+/// The dam break's contract (issue 5, CTVF sec. 4.3): the fluid scheme parameters, the
+/// geometry, artificial viscosity, and snapshots every 0.1 s by default.
+fn dam_break_params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::float("dx", 0.02, Bound::Positive, "particle spacing (m)"),
+        Spec::float("column_width", 1.0, Bound::Positive, "L (m)"),
+        Spec::float("column_height", 2.0, Bound::Positive, "(m)"),
+        Spec::float("tank_width", 4.0, Bound::Positive, "(m)"),
+        Spec::float("tank_height", 3.0, Bound::Positive, "(m)"),
+        Spec::float("alpha", 0.05, Bound::NonNegative, "artificial viscosity"),
+    ];
+    v.extend(scenes::common::scheme_params("sun"));
+    v.extend(common_params(2.5).into_iter().map(|s| match s.name {
+        "output_dt" => Spec::float("output_dt", 0.1, Bound::NonNegative, "snapshot interval (s)"),
+        _ => s,
+    }));
+    v
+}
+
+/// The free-surface detection test's contract (issue 5, CTVF sec. 3.4).
+fn free_surface_params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::choice("shape", &["ring", "patch", "column"], "ring", "fluid shape"),
+        Spec::float("dx", 0.05, Bound::Positive, "particle spacing (m)"),
+    ];
+    v.extend(common_params(1e-4));
+    v
+}
+
 /// The contract of issue 5 ("Walls and free surfaces").
 static STUBS: &[SceneEntry] = &[
     SceneEntry {
@@ -77,6 +106,22 @@ static STUBS: &[SceneEntry] = &[
         params: tank_params,
         build: unbuildable,
         metrics: &["pressure_rel_error", "max_speed"],
+    },
+    SceneEntry {
+        name: "dam_break",
+        dim: 2,
+        about: "stub: dam break (issue 5 contract)",
+        params: dam_break_params,
+        build: unbuildable,
+        metrics: &["toe_rms", "particles_lost", "max_penetration"],
+    },
+    SceneEntry {
+        name: "free_surface_demo",
+        dim: 2,
+        about: "stub: free-surface detection (issue 5 contract)",
+        params: free_surface_params,
+        build: unbuildable,
+        metrics: &["surface_particles", "interior_surface_particles"],
     },
 ];
 
@@ -154,7 +199,9 @@ fn cavity_presets_and_reference_points() {
 fn every_problem_plots_without_results() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");
     let tmp = tempfile::tempdir().unwrap();
-    for name in ["cavity", "cavity_stability", "hydrostatic_tank"] {
+    for name in
+        ["cavity", "cavity_stability", "hydrostatic_tank", "dam_break", "dam_break_stability", "free_surface"]
+    {
         let path = dir.join(format!("{name}.toml"));
         let src = std::fs::read_to_string(&path).unwrap();
         let p = registry::parse_with(&path, &src, "quick", find).unwrap();
@@ -173,4 +220,61 @@ fn every_problem_plots_without_results() {
     assert!(tmp.path().join("figures/fig14a_cavity_u_re100.svg").exists());
     let svg = std::fs::read_to_string(tmp.path().join("figures/fig15b_cavity_v_re1000.svg")).unwrap();
     assert!(svg.contains("Ghia et al. 1982"));
+}
+
+/// The dam-break problems: the presets the brief asks for, the fig. 17 times inside every
+/// preset's end time, normals drawn as arrows, the trade along dx as a spacing.
+#[test]
+fn dam_break_presets_figures_and_stability_sweep() {
+    let load = |name: &str, preset: &str| {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml"));
+        let src = std::fs::read_to_string(&path).unwrap();
+        registry::parse_with(&path, &src, preset, find).unwrap()
+    };
+    let dxs = |p: &registry::Problem| {
+        let mut v: Vec<f64> = p.cases.iter().map(|c| c.params.float("dx")).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v
+    };
+    let (quick, paper) = (load("dam_break", "quick"), load("dam_break", "paper"));
+    for (p, dx, tf) in [(&quick, 0.05, 2.0), (&paper, 0.01, 2.5)] {
+        assert!(p.cases.iter().all(|c| c.params.float("tf") == tf));
+        assert!(dxs(p).contains(&dx));
+        let fig = |id: &str| p.figures.iter().find(|f| f.id == id).unwrap_or_else(|| panic!("{id}"));
+        for (id, t) in [
+            ("fig17a_dam_break_speed_t0.6", 0.6),
+            ("fig17b_dam_break_speed_t1.1", 1.1),
+            ("fig17c_dam_break_speed_t2.0", 2.0),
+        ] {
+            let registry::FigureKind::Particles { field, time, arrows: None } = &fig(id).kind else {
+                panic!()
+            };
+            assert_eq!((field.as_str(), *time), ("speed", Some(t)));
+            assert!(fig(id).select.pick(&p.cases).iter().all(|c| c.params.float("dx") == dx));
+        }
+        let registry::FigureKind::Particles { field, arrows, .. } = &fig("fig03_dam_break_normals").kind
+        else {
+            panic!()
+        };
+        assert_eq!((field.as_str(), arrows.as_deref()), ("free_surface", Some("normal")));
+        assert!(matches!(fig("trade_dam_break").kind, registry::FigureKind::Trade { spacing: true, .. }));
+        let registry::FigureKind::Profile { reference: Some(r), .. } = &fig("fig16_dam_break_toe").kind
+        else {
+            panic!()
+        };
+        assert_eq!(r.x.len(), 9);
+        // ctvf sun (with and without corrections) and ipst at the main resolution.
+        let at: Vec<_> = p.cases.iter().filter(|c| c.params.float("dx") == dx).collect();
+        assert_eq!(at.len(), 3, "{at:?}");
+    }
+    assert_eq!(dxs(&quick), [0.05, 0.1]);
+    let (sq, sp) = (load("dam_break_stability", "quick"), load("dam_break_stability", "paper"));
+    assert_eq!(dxs(&sq), [0.025, 0.05, 0.1]);
+    assert_eq!(dxs(&sp), [0.0125, 0.025, 0.05, 0.1]);
+    assert_eq!((sq.cases.len(), sp.cases.len()), (9, 12));
+    assert!(sq.cases.iter().all(|c| c.params.float("tf") == 1.0));
+    let fs = load("free_surface", "quick");
+    let shapes: Vec<_> = fs.cases.iter().map(|c| c.params.str("shape").to_string()).collect();
+    assert_eq!(shapes, ["ring", "patch", "column"]);
 }

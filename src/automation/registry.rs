@@ -89,6 +89,12 @@ struct FigureFile {
     #[serde(default)]
     field: Option<String>,
     #[serde(default)]
+    time: Option<f64>,
+    #[serde(default)]
+    arrows: Option<String>,
+    #[serde(default)]
+    x_spacing: bool,
+    #[serde(default)]
     file: Option<String>,
     #[serde(default)]
     x_label: Option<String>,
@@ -208,16 +214,26 @@ pub enum FigureKind {
         /// Column holding the exact solution.
         exact: Option<String>,
     },
-    /// The particles of one case's last snapshot, coloured by a point array.
+    /// The particles of one case's snapshot (the last one, or the one nearest `time`),
+    /// coloured by a point array, with an optional vector array drawn as short segments.
     Particles {
         /// Point array (e.g. `pressure`).
         field: String,
+        /// Simulated time of the snapshot drawn (the nearest listed in `fluid.pvd`);
+        /// `None`: the last snapshot.
+        time: Option<f64>,
+        /// A 3-component point array (e.g. `normal`) drawn as segments about one particle
+        /// spacing long at the particles where it is non-zero.
+        arrows: Option<String>,
     },
     /// Error against cost (wall time and particle-steps) with the Pareto front, and the
     /// same as a table with the observed orders of convergence along `x`.
     Trade {
-        /// The resolution parameter (e.g. `nx`); h is taken as `1 / x`.
+        /// The resolution parameter (e.g. `nx`); h is taken as `1 / x`, or as `x` when
+        /// `spacing` (e.g. `dx`).
         x: String,
+        /// `x` is a spacing (h = x) rather than a count (h = 1 / x).
+        spacing: bool,
     },
     /// Outcome map (stable / inaccurate / diverged) of the curve groups against parameter
     /// `x`, and the same as a table.
@@ -751,14 +767,54 @@ fn expand(
         };
         let kind = match f.kind.as_str() {
             "timeseries" => FigureKind::Timeseries { y: need("y", &f.y)?, exact: f.exact.clone() },
-            "particles" => FigureKind::Particles { field: need("field", &f.field)? },
+            "particles" => {
+                if let Some(t) = f.time {
+                    if !(t.is_finite() && t >= 0.0) {
+                        return Err(loc.err(
+                            span,
+                            &format!("{key}.time"),
+                            format!("`{t}` is not a time >= 0"),
+                        ));
+                    }
+                    // A snapshot after the end time does not exist: the figure would
+                    // silently show another time. Every preset is checked.
+                    let picked = select.pick(&cases);
+                    if let Some(c) = picked
+                        .iter()
+                        .find(|c| matches!(c.params.0.get("tf"), Some(Value::Float(tf)) if *tf < t))
+                    {
+                        return Err(loc.err(
+                            span,
+                            &format!("{key}.time"),
+                            format!(
+                                "t = {t} is after the end time tf = {} of case `{}` in preset `{preset}`",
+                                c.params.0["tf"], c.name
+                            ),
+                        ));
+                    }
+                }
+                if let Some(a) = &f.arrows {
+                    if a.is_empty() || a.contains(['"', '<', '>']) {
+                        return Err(loc.err(
+                            span,
+                            &format!("{key}.arrows"),
+                            format!("`{a}` is not a point array name"),
+                        ));
+                    }
+                }
+                FigureKind::Particles {
+                    field: need("field", &f.field)?,
+                    time: f.time,
+                    arrows: f.arrows.clone(),
+                }
+            }
             "trade" => {
                 need("metric", &f.metric)?;
                 let x = need("x", &f.x)?;
                 if !specs.iter().any(|s| s.name == x) {
                     return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
                 }
-                FigureKind::Trade { x }
+                FigureKind::Trade { x, spacing: f.x_spacing }
             }
             "stability" => {
                 need("metric", &f.metric)?;
@@ -804,6 +860,18 @@ fn expand(
             if set && !matches!(kind, FigureKind::Profile { .. }) {
                 return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `profile` takes `{k}`")));
             }
+        }
+        for (k, set) in [("time", f.time.is_some()), ("arrows", f.arrows.is_some())] {
+            if set && !matches!(kind, FigureKind::Particles { .. }) {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.{k}"),
+                    format!("only kind `particles` takes `{k}`"),
+                ));
+            }
+        }
+        if f.x_spacing && !matches!(kind, FigureKind::Trade { .. }) {
+            return Err(loc.err(span, &format!("{key}.x_spacing"), "only kind `trade` takes `x_spacing`"));
         }
         if (f.converges || f.lower.is_some()) && f.metric.is_none() {
             return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));

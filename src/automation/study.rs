@@ -110,32 +110,82 @@ fn data_array<'a>(xml: &'a str, from: usize, tag_has: &str) -> Option<&'a str> {
     }
 }
 
-/// Points (x, y) and one scalar point array of the last snapshot listed in `fluid.pvd`.
-fn last_snapshot(dir: &Path, field: &str) -> Result<(Vec<f64>, Vec<f64>, Vec<f64>, f64), String> {
+/// One snapshot of a case read for a particle figure.
+struct Snapshot {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    value: Vec<f64>,
+    /// x and y components of the `arrows` array, if asked for.
+    arrows: Option<(Vec<f64>, Vec<f64>)>,
+    /// Its time.
+    t: f64,
+}
+
+/// The snapshots listed in `fluid.pvd`: (time, file), in file order.
+fn pvd_entries(dir: &Path) -> Result<Vec<(f64, String)>, String> {
     let pvd = dir.join("fluid.pvd");
     let s = std::fs::read_to_string(&pvd).map_err(|e| format!("{}: {e}", pvd.display()))?;
-    let (t, file) = s
+    let list: Vec<(f64, String)> = s
         .lines()
         .filter_map(|l| {
             let f = l.split("file=\"").nth(1)?.split('"').next()?;
             let t: f64 = l.split("timestep=\"").nth(1)?.split('"').next()?.parse().ok()?;
             Some((t, f.to_string()))
         })
-        .last()
-        .ok_or_else(|| format!("{}: no snapshot listed", pvd.display()))?;
+        .collect();
+    if list.is_empty() {
+        return Err(format!("{}: no snapshot listed", pvd.display()));
+    }
+    Ok(list)
+}
+
+/// The entry nearest `time` (the first of equally near ones), or the last one.
+fn pick_snapshot(list: &[(f64, String)], time: Option<f64>) -> &(f64, String) {
+    match time {
+        None => list.last().expect("non-empty"),
+        Some(t) => {
+            list.iter().fold(&list[0], |best, e| if (e.0 - t).abs() < (best.0 - t).abs() { e } else { best })
+        }
+    }
+}
+
+/// Points (x, y), the scalar point array `field` and the x, y components of the vector
+/// point array `arrows` of the snapshot listed in `fluid.pvd` nearest `time` (the last one
+/// without a time).
+fn snapshot(dir: &Path, field: &str, time: Option<f64>, arrows: Option<&str>) -> Result<Snapshot, String> {
+    let list = pvd_entries(dir)?;
+    let (t, file) = pick_snapshot(&list, time).clone();
     let path = dir.join(&file);
     let xml = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
     let nums = |s: &str| -> Vec<f64> { s.split_whitespace().filter_map(|x| x.parse().ok()).collect() };
-    let values = data_array(&xml, 0, &format!("Name=\"{field}\""))
-        .map(nums)
-        .ok_or_else(|| format!("{}: no point array `{field}`", path.display()))?;
+    let array = |name: &str| {
+        data_array(&xml, 0, &format!("Name=\"{name}\""))
+            .map(nums)
+            .ok_or_else(|| format!("{}: no point array `{name}`", path.display()))
+    };
+    let value = array(field)?;
     let pts_at = xml.find("<Points>").ok_or_else(|| format!("{}: no <Points>", path.display()))?;
     let pts = data_array(&xml, pts_at, "DataArray")
         .map(nums)
         .ok_or_else(|| format!("{}: unreadable <Points>", path.display()))?;
-    let x = pts.iter().step_by(3).copied().collect();
+    let x: Vec<f64> = pts.iter().step_by(3).copied().collect();
     let y = pts.iter().skip(1).step_by(3).copied().collect();
-    Ok((x, y, values, t))
+    let arrows = match arrows {
+        None => None,
+        Some(a) => {
+            let v = array(a)?;
+            if v.len() != 3 * x.len() {
+                return Err(format!(
+                    "{}: point array `{a}` has {} values, not 3 per point ({} points)",
+                    path.display(),
+                    v.len(),
+                    x.len()
+                ));
+            }
+            Some((v.iter().step_by(3).copied().collect(), v.iter().skip(1).step_by(3).copied().collect()))
+        }
+    };
+    Ok(Snapshot { x, y, value, arrows, t })
 }
 
 /// Regenerates the figures and tables of `p` from the results under `output` into
@@ -275,42 +325,57 @@ fn figure(
             )?;
             Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
         }
-        FigureKind::Particles { field } => {
+        FigureKind::Particles { field, time, arrows } => {
+            let at = time.map(|t| format!(" at t = {t} s")).unwrap_or_default();
             let Some(r) = rs.iter().find(|r| r.summary.is_some()) else {
                 report::particle_figure(
                     &report::ScatterField {
-                        title: format!("{} (no result)", f.title),
+                        title: format!("{}{at} (no result)", f.title),
                         x: vec![],
                         y: vec![],
                         value: vec![],
                         value_label: field.clone(),
                         range: None,
                         aspect_equal: true,
+                        arrows: None,
                     },
                     &stem,
                 )?;
                 return Ok(vec![fig_item(&f.id, &caption, missing_note(&rs))]);
             };
-            let (x, y, v, t) = last_snapshot(&r.entry.dir, field)?;
+            let s = snapshot(&r.entry.dir, field, *time, arrows.as_deref())?;
+            let t = s.t;
             let (lo, hi) =
-                v.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+                s.value.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| (a.min(x), b.max(x)));
+            let n_arrows = s.arrows.as_ref().map(|(u, v)| {
+                u.iter().zip(v).filter(|(a, b)| a.hypot(**b) > 0.0 && a.is_finite() && b.is_finite()).count()
+            });
             report::particle_figure(
                 &report::ScatterField {
                     title: format!("{} (t = {t:.2} s)", f.title),
-                    x,
-                    y,
-                    value: v,
+                    x: s.x,
+                    y: s.y,
+                    value: s.value,
                     value_label: with_unit(field),
                     range: None,
                     aspect_equal: true,
+                    arrows: s.arrows.map(|(u, v)| report::Arrows { u, v, length: None }),
                 },
                 &stem,
             )?;
+            let asked = match time {
+                Some(want) if (want - t).abs() > 1e-9 => format!(" (nearest snapshot to t = {want} s)"),
+                _ => String::new(),
+            };
+            let arrows_note = match (arrows, n_arrows) {
+                (Some(a), Some(n)) => format!(" `{a}` drawn at {n} particle(s)."),
+                _ => String::new(),
+            };
             Ok(vec![fig_item(
                 &f.id,
                 &caption,
                 format!(
-                    "case {} at t = {t:.3} s: {field} from {} to {}. {}",
+                    "case {} at t = {t:.3} s{asked}: {field} from {} to {}.{arrows_note} {}",
                     r.case.name,
                     fmt(lo),
                     fmt(hi),
@@ -345,7 +410,7 @@ fn figure(
             )?;
             Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
         }
-        FigureKind::Trade { x } => trade(f, &rs, x, figures, tables, &caption),
+        FigureKind::Trade { x, spacing } => trade(f, &rs, x, *spacing, figures, tables, &caption),
         FigureKind::Stability { x, max } => stability(f, &rs, x, *max, figures, tables, &caption),
     }
 }
@@ -367,6 +432,7 @@ fn trade(
     f: &Figure,
     rs: &[Run],
     res: &str,
+    spacing: bool,
     figures: &Path,
     tables: &Path,
     caption: &str,
@@ -433,7 +499,10 @@ fn trade(
     let mut notes = Vec::new();
     for (g, mut ds) in groups {
         ds.sort_by(|a, b| param_f64(a.0.case, res).total_cmp(&param_f64(b.0.case, res)));
-        let h: Vec<f64> = ds.iter().map(|d| 1.0 / param_f64(d.0.case, res)).collect();
+        let h: Vec<f64> = ds
+            .iter()
+            .map(|d| if spacing { param_f64(d.0.case, res) } else { 1.0 / param_f64(d.0.case, res) })
+            .collect();
         let e: Vec<f64> = ds.iter().map(|d| d.1).collect();
         let orders = report::observed_order(&h, &e);
         for (i, d) in ds.iter().enumerate() {
@@ -700,5 +769,137 @@ paper = "Fig. 14a"
         assert!(!svg.contains("nx = 16"));
         let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
         assert!(ours.contains("No result for: nx16"), "{ours}");
+    }
+
+    /// A finished case with snapshots at t = 0, 0.5004 and 1.0 (pressure 0, 1, 2 and a
+    /// normal at two particles of the middle one), written by the solver's own writers.
+    fn case_with_snapshots(output: &Path, p: &Problem) -> Entry {
+        use crate::solver::output::vtu::{write_vtu, Field, Series};
+        let e = Entry::new(output, p, &p.cases[0]);
+        std::fs::create_dir_all(&e.dir).unwrap();
+        let pts: Vec<[f64; 3]> = (0..4).map(|i| [i as f64 * 0.1, 0.0, 0.0]).collect();
+        let mut series = Series::new(e.dir.join("fluid.pvd"));
+        for (k, t) in [0.0, 0.5004, 1.0].into_iter().enumerate() {
+            let file = format!("fluid_{k:05}.vtu");
+            let normal: Vec<[f64; 3]> =
+                (0..4).map(|i| if k == 1 && i >= 2 { [0.0, 1.0, 0.0] } else { [0.0; 3] }).collect();
+            write_vtu(
+                &e.dir.join(&file),
+                &pts,
+                &[Field::Scalar("pressure", vec![k as f64; 4]), Field::Vector("normal", normal)],
+            )
+            .unwrap();
+            series.push(t, &file).unwrap();
+        }
+        Summary {
+            scene: "taylor_green".into(),
+            params: p.cases[0].params.to_json(),
+            particles: 4,
+            steps: 10,
+            final_time: 1.0,
+            wall_seconds: 0.1,
+            particle_steps_per_second: 1.0,
+            threads: 1,
+            status: Status::Completed,
+            reason: None,
+            step: None,
+            metrics: [("l1_velocity_final".to_string(), 0.1)].into(),
+            provenance: Provenance::now(chrono::Utc::now()),
+        }
+        .write(&e.dir)
+        .unwrap();
+        e
+    }
+
+    const PARTICLES: &str = r#"
+title = "t"
+scene = "taylor_green"
+[presets.quick]
+tf = 1.0
+[[cases]]
+name = "one"
+params = { tf = "$tf" }
+[[figures]]
+id = "p_t06"
+kind = "particles"
+title = "pressure"
+field = "pressure"
+time = 0.6
+arrows = "normal"
+paper = "Fig. 3"
+[[figures]]
+id = "p_last"
+kind = "particles"
+title = "pressure, last"
+field = "pressure"
+"#;
+
+    /// `time` picks the snapshot nearest it, `arrows` overlays the vector array where it
+    /// is non-zero; without them the last snapshot is drawn, plain.
+    #[test]
+    fn particles_at_a_time_with_arrows() {
+        let root = tempfile::tempdir().unwrap();
+        let root = root.path();
+        let p = registry::parse(&root.join("problems/pp.toml"), PARTICLES, "quick").unwrap();
+        assert_eq!(
+            p.figures[0].kind,
+            FigureKind::Particles {
+                field: "pressure".into(),
+                time: Some(0.6),
+                arrows: Some("normal".into())
+            }
+        );
+        let output = root.join("output");
+        case_with_snapshots(&output, &p);
+        let manuscript = root.join("manuscript");
+        let section = regenerate(&p, &output, &manuscript).unwrap();
+        let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
+        assert!(ours.contains("at t = 0.500 s (nearest snapshot to t = 0.6 s)"), "{ours}");
+        assert!(ours.contains("pressure from 1.000e0 to 1.000e0"), "{ours}");
+        assert!(ours.contains("`normal` drawn at 2 particle(s)"), "{ours}");
+        let svg = check_figure(&manuscript.join("figures/p_t06"), (900, 720), &["pressure (t = 0.50 s)"]);
+        assert_eq!(svg.matches("stroke=\"#D73027\"").count(), 2);
+        let Item::Figure { ours, .. } = &section.items[1] else { panic!() };
+        assert!(ours.contains("at t = 1.000 s:") && ours.contains("from 2.000e0"), "{ours}");
+        let svg =
+            check_figure(&manuscript.join("figures/p_last"), (900, 720), &["pressure, last (t = 1.00 s)"]);
+        assert!(!svg.contains("#D73027"));
+
+        // Nearest, ties to the first; no time: the last.
+        let list: Vec<(f64, String)> = [0.0, 0.5, 1.0].iter().map(|t| (*t, format!("{t}"))).collect();
+        assert_eq!(pick_snapshot(&list, Some(0.25)).0, 0.0);
+        assert_eq!(pick_snapshot(&list, Some(0.26)).0, 0.5);
+        assert_eq!(pick_snapshot(&list, Some(7.0)).0, 1.0);
+        assert_eq!(pick_snapshot(&list, None).0, 1.0);
+
+        // An arrows array that is not a vector, or missing, names the file and the array.
+        let e = snapshot(&Entry::new(&output, &p, &p.cases[0]).dir, "pressure", None, Some("pressure"));
+        assert!(e.err().unwrap().contains("not 3 per point"));
+        let e = snapshot(&Entry::new(&output, &p, &p.cases[0]).dir, "pressure", None, Some("nope"));
+        assert!(e.err().unwrap().contains("no point array `nope`"));
+    }
+
+    /// `time` after a selected case's end time, a negative time, and `time` or `arrows`
+    /// on another kind are errors naming the key.
+    #[test]
+    fn particles_time_and_arrows_are_checked() {
+        let path = Path::new("x.toml");
+        let e = registry::parse(path, &PARTICLES.replace("time = 0.6", "time = 1.5"), "quick").unwrap_err();
+        assert!(e.contains("figures.p_t06.time") && e.contains("after the end time tf = 1"), "{e}");
+        let e = registry::parse(path, &PARTICLES.replace("time = 0.6", "time = -1.0"), "quick").unwrap_err();
+        assert!(e.contains("figures.p_t06.time"), "{e}");
+        let e = registry::parse(
+            path,
+            &PARTICLES.replace(
+                "kind = \"particles\"\ntitle = \"pressure\"\n",
+                "kind = \"timeseries\"\ntitle = \"pressure\"\ny = \"u_max\"\n",
+            ),
+            "quick",
+        )
+        .unwrap_err();
+        assert!(e.contains("only kind `particles` takes"), "{e}");
+        let src = format!("{PARTICLES}x_spacing = true\n");
+        let e = registry::parse(path, &src, "quick").unwrap_err();
+        assert!(e.contains("only kind `trade` takes `x_spacing`"), "{e}");
     }
 }

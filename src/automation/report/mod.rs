@@ -27,7 +27,7 @@ pub use manuscript::{write_manuscript, Item, Manuscript, Section};
 pub use map::{outcome_map, Outcome, OutcomeMap};
 pub use order::observed_order;
 pub use pareto::{pareto_figure, pareto_front, ParetoFigure};
-pub use particles::{particle_figure, ScatterField};
+pub use particles::{particle_figure, Arrows, ScatterField};
 pub use table::{write_table, Table};
 
 #[cfg(test)]

@@ -1,4 +1,5 @@
-//! Particle figures: particles as dots coloured by a field, with a colour bar.
+//! Particle figures: particles as dots coloured by a field, with a colour bar, and an
+//! optional vector field (e.g. free-surface normals) drawn as short segments.
 
 use super::canvas::{self, Axis, Render, MARGIN, X_LABEL_AREA, Y_LABEL_AREA};
 use super::colors::viridis;
@@ -27,6 +28,101 @@ pub struct ScatterField {
     pub range: Option<(f64, f64)>,
     /// Same length scale on both axes (the data ranges are widened to fit the canvas).
     pub aspect_equal: bool,
+    /// A vector per particle drawn over the dots as a segment from the particle along
+    /// the vector's direction; `None`: no overlay.
+    pub arrows: Option<Arrows>,
+}
+
+/// A vector point array drawn as segments of one length (direction only) at the
+/// particles where it is non-zero and finite.
+#[derive(Clone, Debug)]
+pub struct Arrows {
+    /// x components, one per particle.
+    pub u: Vec<f64>,
+    /// y components, one per particle.
+    pub v: Vec<f64>,
+    /// Segment length in data units; `None`: the typical particle spacing (median
+    /// nearest-neighbour distance).
+    pub length: Option<f64>,
+}
+
+/// Colour of the vector segments (red: distinct from the viridis dots).
+const ARROW: RGBColor = RGBColor(215, 48, 39);
+
+impl Arrows {
+    /// The segments `(start, end)` in data units over particles at `x`, `y`.
+    pub(crate) fn segments(&self, x: &[f64], y: &[f64]) -> Vec<((f64, f64), (f64, f64))> {
+        let len = self.length.unwrap_or_else(|| typical_spacing(x, y));
+        let n = x.len().min(y.len()).min(self.u.len()).min(self.v.len());
+        (0..n)
+            .filter_map(|i| {
+                let (u, v) = (self.u[i], self.v[i]);
+                let norm = u.hypot(v);
+                (norm > 0.0 && norm.is_finite() && x[i].is_finite() && y[i].is_finite())
+                    .then(|| ((x[i], y[i]), (x[i] + len * u / norm, y[i] + len * v / norm)))
+            })
+            .collect()
+    }
+}
+
+/// The median distance from a particle to its nearest neighbour (1 for fewer than two
+/// finite particles), found on a grid of cells no smaller than the mean spacing over the
+/// bounding box, so the nearest neighbour of a particle is in its own or an adjacent cell.
+pub(crate) fn typical_spacing(x: &[f64], y: &[f64]) -> f64 {
+    let pts: Vec<(f64, f64)> =
+        x.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect();
+    if pts.len() < 2 {
+        return 1.0;
+    }
+    let (x0, x1, y0, y1) = pts
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY, f64::INFINITY, f64::NEG_INFINITY), |(a, b, c, d), p| {
+            (a.min(p.0), b.max(p.0), c.min(p.1), d.max(p.1))
+        });
+    let (wx, wy) = (x1 - x0, y1 - y0);
+    let n = pts.len() as f64;
+    // Area per particle over the box (a line of particles: length per particle).
+    let cell = if wx > 0.0 && wy > 0.0 { (wx * wy / n).sqrt() } else { wx.max(wy) / n };
+    if cell <= 0.0 {
+        return 1.0; // every particle at one point
+    }
+    let (nx, ny) = ((wx / cell) as usize + 1, (wy / cell) as usize + 1);
+    let key = |p: &(f64, f64)| {
+        (((p.0 - x0) / cell) as usize).min(nx - 1) + nx * (((p.1 - y0) / cell) as usize).min(ny - 1)
+    };
+    let mut cells: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+    for (i, p) in pts.iter().enumerate() {
+        cells.entry(key(p)).or_default().push(i);
+    }
+    let mut nearest: Vec<f64> = pts
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| {
+            let k = key(p);
+            let (cx, cy) = ((k % nx) as i64, (k / nx) as i64);
+            let mut best = f64::INFINITY;
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let (a, b) = (cx + dx, cy + dy);
+                    if a < 0 || b < 0 || a >= nx as i64 || b >= ny as i64 {
+                        continue;
+                    }
+                    for &j in cells.get(&(a as usize + nx * b as usize)).into_iter().flatten() {
+                        let d = (pts[j].0 - p.0).hypot(pts[j].1 - p.1);
+                        if j != i && d > 0.0 {
+                            best = best.min(d);
+                        }
+                    }
+                }
+            }
+            best.is_finite().then_some(best)
+        })
+        .collect();
+    if nearest.is_empty() {
+        return cell;
+    }
+    let mid = nearest.len() / 2;
+    *nearest.select_nth_unstable_by(mid, f64::total_cmp).1
 }
 
 /// Writes `f` to `<stem>.png` and `<stem>.svg` (900 x 720 pixels): particles as small
@@ -97,6 +193,14 @@ impl Render for ScatterField {
             Circle::new((self.x[i], self.y[i]), r, c.filled())
         });
         chart.draw_series(dots).map_err(|e| e.to_string())?;
+        if let Some(a) = &self.arrows {
+            let segs = a.segments(&self.x, &self.y);
+            chart
+                .draw_series(
+                    segs.into_iter().map(|(p, q)| PathElement::new(vec![p, q], ARROW.stroke_width(1))),
+                )
+                .map_err(|e| e.to_string())?;
+        }
         colour_bar(&bar, lo, hi, &self.value_label)
     }
 }
@@ -165,6 +269,7 @@ mod tests {
             value_label: "p [Pa]".into(),
             range: None,
             aspect_equal: true,
+            arrows: None,
         };
         particle_figure(&f, &stem).unwrap();
         check_figure(&stem, (900, 720), &["Taylor-Green pressure, t = 2 s", "p [Pa]"]);
@@ -185,10 +290,70 @@ mod tests {
             value_label: "rho [kg/m^3]".into(),
             range: Some((2.0, 4.0)),
             aspect_equal: false,
+            arrows: None,
         };
         particle_figure(&f, &dir.path().join("c")).unwrap();
         let empty = ScatterField { x: vec![], y: vec![], value: vec![], range: None, ..f };
         particle_figure(&empty, &dir.path().join("e")).unwrap();
         assert_eq!(empty.value_range(), (0.0, 1.0));
+    }
+
+    /// A ring of particles with outward normals on its outer layer: one red segment per
+    /// non-zero normal, one particle spacing long, in both PNG and SVG.
+    #[test]
+    fn normals_drawn_as_segments_where_non_zero() {
+        let dir = tempfile::tempdir().unwrap();
+        let stem = dir.path().join("ring_normals");
+        let dx = 0.05;
+        let (mut x, mut y, mut fs, mut u, mut v) = (vec![], vec![], vec![], vec![], vec![]);
+        for layer in 0..4 {
+            let r = 0.5 + layer as f64 * dx;
+            let n = (std::f64::consts::TAU * r / dx).round() as usize;
+            for k in 0..n {
+                let a = std::f64::consts::TAU * k as f64 / n as f64;
+                x.push(r * a.cos());
+                y.push(r * a.sin());
+                let outer = layer == 3;
+                fs.push(if outer { 1.0 } else { 0.0 });
+                u.push(if outer { 2.0 * a.cos() } else { 0.0 }); // not unit: direction only
+                v.push(if outer { 2.0 * a.sin() } else { 0.0 });
+            }
+        }
+        let outer = fs.iter().filter(|f| **f == 1.0).count();
+        let spacing = typical_spacing(&x, &y);
+        assert!((spacing - dx).abs() < 0.2 * dx, "{spacing}");
+        let arrows = Arrows { u, v, length: None };
+        let segs = arrows.segments(&x, &y);
+        assert_eq!(segs.len(), outer);
+        for ((x0, y0), (x1, y1)) in &segs {
+            assert!(((x1 - x0).hypot(y1 - y0) - spacing).abs() < 1e-12);
+            assert!(x1.hypot(*y1) > x0.hypot(*y0)); // outward
+        }
+        let f = ScatterField {
+            title: "ring: free surface and normals".into(),
+            x,
+            y,
+            value: fs,
+            value_label: "free_surface".into(),
+            range: None,
+            aspect_equal: true,
+            arrows: Some(arrows),
+        };
+        particle_figure(&f, &stem).unwrap();
+        let svg = check_figure(&stem, (900, 720), &["ring: free surface and normals", "free_surface"]);
+        let red = svg.matches("stroke=\"#D73027\"").count();
+        assert_eq!(red, outer, "one segment per non-zero normal");
+        // Without the overlay, no segment.
+        particle_figure(&ScatterField { arrows: None, ..f }, &stem).unwrap();
+        let svg = std::fs::read_to_string(stem.with_extension("svg")).unwrap();
+        assert_eq!(svg.matches("stroke=\"#D73027\"").count(), 0);
+    }
+
+    #[test]
+    fn spacing_of_degenerate_sets() {
+        assert_eq!(typical_spacing(&[], &[]), 1.0);
+        assert_eq!(typical_spacing(&[1.0, 1.0], &[2.0, 2.0]), 1.0);
+        let x: Vec<f64> = (0..10).map(|i| i as f64 * 0.1).collect();
+        assert!((typical_spacing(&x, &vec![0.0; 10]) - 0.1).abs() < 1e-12); // a line
     }
 }
