@@ -12,7 +12,7 @@
 //! `centerline_v.csv` (x, v), 101 points each.
 
 use super::common::{
-    fluid_scheme, particle_count, restore_sim, scheme_params, shepard, snapshot_bodies, FluidConstants,
+    fluid_scheme, forward_to_sim, restore_sim, scheme_params, shepard, snapshot_bodies, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -21,7 +21,7 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
-use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -180,15 +180,7 @@ impl Cavity {
 }
 
 impl SceneRun for Cavity {
-    fn particles(&self) -> usize {
-        particle_count(&self.sim)
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn steps(&self) -> u64 {
-        self.sim.steps()
-    }
+    forward_to_sim!();
     fn plan(&self) -> String {
         let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
         format!(
@@ -197,14 +189,6 @@ impl SceneRun for Cavity {
             self.sim.fluid().h,
             self.sim.state.scheme
         )
-    }
-    fn advance(
-        &mut self,
-        t_stop: f64,
-        t_end: f64,
-        on_step: &mut dyn FnMut(f64, u64) -> bool,
-    ) -> Result<bool, Divergence> {
-        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let ke = self.kinetic_energy();

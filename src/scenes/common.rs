@@ -162,6 +162,31 @@ pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize
     (den > 0.0).then(|| num / den)
 }
 
+/// The [`SceneRun`](super::SceneRun) methods every scene forwards to its `sim` field
+/// (a `Simulation<2>`): particle count, time, steps, advancing.
+macro_rules! forward_to_sim {
+    () => {
+        fn particles(&self) -> usize {
+            $crate::scenes::common::particle_count(&self.sim)
+        }
+        fn time(&self) -> f64 {
+            self.sim.time()
+        }
+        fn steps(&self) -> u64 {
+            self.sim.steps()
+        }
+        fn advance(
+            &mut self,
+            t_stop: f64,
+            t_end: f64,
+            on_step: &mut dyn FnMut(f64, u64) -> bool,
+        ) -> Result<bool, $crate::solver::simulation::Divergence> {
+            self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
+        }
+    };
+}
+pub(crate) use forward_to_sim;
+
 /// Particles in every body of `sim`.
 pub fn particle_count(sim: &Simulation<2>) -> usize {
     sim.fluid().len() + sim.walls.as_ref().map_or(0, |w| w.wall.len())

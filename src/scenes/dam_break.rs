@@ -11,7 +11,9 @@
 //! particle beyond a wall surface, in dx. `timeseries.csv`: `t, toe, t_star, toe_star, max_speed`, with the toe Z the
 //! largest x of the fluid, t* = t sqrt(2 g / L) and Z/L.
 
-use super::common::{fluid_scheme, particle_count, restore_sim, scheme_params, snapshot_bodies, FluidConstants};
+use super::common::{
+    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+};
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -20,7 +22,7 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
-use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -52,7 +54,12 @@ fn params() -> Vec<Spec> {
     let mut common = common_params(2.5);
     for s in common.iter_mut() {
         if s.name == "output_dt" {
-            *s = Spec::float("output_dt", 0.1, Bound::NonNegative, "interval between ParaView snapshots (s); 0: tf/10");
+            *s = Spec::float(
+                "output_dt",
+                0.1,
+                Bound::NonNegative,
+                "interval between ParaView snapshots (s); 0: tf/10",
+            );
         }
     }
     v.extend(common);
@@ -120,7 +127,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let x = lattice(0.0, l, 0.0, hc, dx);
     let n = x.len();
     let p0: Vec<f64> = x.iter().map(|x| RHO0 * G * (hc - x[1])).collect();
-    let init = FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: p0, x };
+    let init =
+        FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: p0, x };
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
     let walls = box_walls(tw, th, dx, LAYERS, false);
     let wall = Wall::new(
@@ -168,15 +176,7 @@ impl DamBreak {
 }
 
 impl SceneRun for DamBreak {
-    fn particles(&self) -> usize {
-        particle_count(&self.sim)
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn steps(&self) -> u64 {
-        self.sim.steps()
-    }
+    forward_to_sim!();
     fn plan(&self) -> String {
         let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
         format!(
@@ -185,14 +185,6 @@ impl SceneRun for DamBreak {
             self.sim.fluid().h,
             self.sim.state.scheme
         )
-    }
-    fn advance(
-        &mut self,
-        t_stop: f64,
-        t_end: f64,
-        on_step: &mut dyn FnMut(f64, u64) -> bool,
-    ) -> Result<bool, Divergence> {
-        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (t, toe) = (self.sim.time(), self.toe());

@@ -6,7 +6,9 @@
 //! (found on the surface but not in the outer layer: must be 0), `outer_layer_missed`
 //! (outer-layer particles not found).
 
-use super::common::{fluid_scheme, particle_count, restore_sim, scheme_params, snapshot_bodies, FluidConstants};
+use super::common::{
+    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+};
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -15,7 +17,7 @@ use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
-use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -55,7 +57,10 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, Box<dyn Fn(&Vector<2>) -> bool>) =
         match p.str("shape") {
             "ring" => (
-                lattice(-1.0, 1.0, -1.0, 1.0, dx).into_iter().filter(|x| (0.5..1.0).contains(&x.norm())).collect(),
+                lattice(-1.0, 1.0, -1.0, 1.0, dx)
+                    .into_iter()
+                    .filter(|x| (0.5..1.0).contains(&x.norm()))
+                    .collect(),
                 Vec::new(),
                 Box::new(move |x: &Vector<2>| x.norm() > 1.0 - dx || x.norm() < 0.5 + dx),
             ),
@@ -85,7 +90,13 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     let n = x.len();
-    let init = FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: vec![0.0; n], x };
+    let init = FluidInit {
+        u: vec![Vector::zeros(); n],
+        m: vec![RHO0 * dx * dx; n],
+        rho: vec![RHO0; n],
+        p: vec![0.0; n],
+        x,
+    };
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
     let wall = (!walls.is_empty())
         .then(|| {
@@ -133,29 +144,17 @@ impl Demo {
 }
 
 impl SceneRun for Demo {
-    fn particles(&self) -> usize {
-        particle_count(&self.sim)
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn steps(&self) -> u64 {
-        self.sim.steps()
-    }
+    forward_to_sim!();
     fn plan(&self) -> String {
         format!("body `fluid`: {} particles\n{}", self.sim.fluid().len(), self.sim.state.scheme)
     }
-    fn advance(
-        &mut self,
-        t_stop: f64,
-        t_end: f64,
-        on_step: &mut dyn FnMut(f64, u64) -> bool,
-    ) -> Result<bool, Divergence> {
-        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
-    }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (found, interior, _) = self.counts();
-        vec![("t", self.sim.time()), ("surface_particles", found as f64), ("interior_surface_particles", interior as f64)]
+        vec![
+            ("t", self.sim.time()),
+            ("surface_particles", found as f64),
+            ("interior_surface_particles", interior as f64),
+        ]
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))

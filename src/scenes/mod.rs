@@ -70,8 +70,13 @@ pub struct SceneEntry {
 }
 
 /// Every scene.
-pub const SCENES: &[SceneEntry] =
-    &[taylor_green::ENTRY, cavity::ENTRY, dam_break::ENTRY, hydrostatic_tank::ENTRY, free_surface_demo::ENTRY];
+pub const SCENES: &[SceneEntry] = &[
+    taylor_green::ENTRY,
+    cavity::ENTRY,
+    dam_break::ENTRY,
+    hydrostatic_tank::ENTRY,
+    free_surface_demo::ENTRY,
+];
 
 /// Looks a scene up by name.
 pub fn find(name: &str) -> Result<&'static SceneEntry, String> {

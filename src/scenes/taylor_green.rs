@@ -13,7 +13,9 @@
 //! - `p_l1_final`: mean |(p - mean p) - (p_e - mean p_e)| over max |p_e| at tf;
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
-use super::common::{fluid_scheme, restore_sim, scheme_params, snapshot_bodies, FluidConstants};
+use super::common::{
+    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
@@ -21,7 +23,7 @@ use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
 use crate::solver::scheme::DensityModel;
-use crate::solver::simulation::{Divergence, Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -193,15 +195,7 @@ impl TaylorGreen {
 }
 
 impl SceneRun for TaylorGreen {
-    fn particles(&self) -> usize {
-        self.sim.fluid().len()
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn steps(&self) -> u64 {
-        self.sim.steps()
-    }
+    forward_to_sim!();
     fn plan(&self) -> String {
         format!(
             "body `fluid`: {} particles, h = {:.4e}, kernel {:?}, periodic unit square\n{}",
@@ -210,14 +204,6 @@ impl SceneRun for TaylorGreen {
             self.sim.kernel.kind(),
             self.sim.state.scheme
         )
-    }
-    fn advance(
-        &mut self,
-        t_stop: f64,
-        t_end: f64,
-        on_step: &mut dyn FnMut(f64, u64) -> bool,
-    ) -> Result<bool, Divergence> {
-        self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
     }
     fn save_state(&self) -> serde_json::Value {
         serde_json::json!({ "sim": &self.sim.state, "l1_max": self.l1_max })

@@ -5,9 +5,9 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
-use crate::solver::scheme::{SurfaceFields, 
+use crate::solver::scheme::{
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
-    Shifting, WallSet,
+    Shifting, SurfaceFields, WallSet,
 };
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -267,7 +267,15 @@ impl<const D: usize> Simulation<D> {
             fs.detect(&st.fluid, &self.neighbours, walls, rho0);
         }
         let surface = self.surface.as_ref();
-        self.passes.accelerations(&st.fluid, &self.neighbours, walls, surface, &st.scheme, &mut st.rates, dt_nominal);
+        self.passes.accelerations(
+            &st.fluid,
+            &self.neighbours,
+            walls,
+            surface,
+            &st.scheme,
+            &mut st.rates,
+            dt_nominal,
+        );
         let clock = lap(clock, &mut self.times.accelerations);
         st.ipst_iterations = self.passes.ipst(
             &st.fluid,

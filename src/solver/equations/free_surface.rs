@@ -57,10 +57,10 @@ mod tests {
     fn shifts_are_tangential_near_the_surface_and_zero_on_it() {
         let n = Vector::<2>::new(0.0, 1.0);
         let s = Vector::<2>::new(0.3, 0.4);
-        assert_eq!(adjust_shift(s, true, true, &n), Vector::zeros());
+        assert_eq!(adjust_shift(s, true, true, &n), Vector::<2>::zeros());
         assert_eq!(adjust_shift(s, false, true, &n), Vector::<2>::new(0.3, 0.0));
         assert_eq!(adjust_shift(s, false, false, &n), s);
-        assert_eq!(cut_normal(Vector::<2>::new(0.1, 0.0), 1.0), Vector::zeros());
+        assert_eq!(cut_normal(Vector::<2>::new(0.1, 0.0), 1.0), Vector::<2>::zeros());
         assert_eq!(cut_normal(Vector::<2>::new(3.0, 4.0), 1.0), Vector::<2>::new(0.6, 0.8));
     }
 }

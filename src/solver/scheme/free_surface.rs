@@ -81,7 +81,9 @@ impl<const D: usize> SurfaceFields<D> {
                 return;
             }
             let mut covered = false;
-            nl.for_each(i, x, |_, xij, r2, &(w, g)| covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g)));
+            nl.for_each(i, x, |_, xij, r2, &(w, g)| {
+                covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g))
+            });
             if let Some(ws) = walls {
                 ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |_, xij, r2, &(w, g)| {
                     covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g))

@@ -10,8 +10,8 @@ mod free_surface;
 mod passes;
 mod walls;
 
-pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
 pub use free_surface::SurfaceFields;
+pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
 pub use walls::WallSet;
 
 use serde::{Deserialize, Serialize};
@@ -373,7 +373,10 @@ impl fmt::Display for FluidScheme {
             writeln!(f, "  gravity      {g:?}")?;
         }
         if self.free_surface.is_some() {
-            writeln!(f, "  surface      detected every step (sec. 3.4); shifting tangential near it (eqs. 44-45)")?;
+            writeln!(
+                f,
+                "  surface      detected every step (sec. 3.4); shifting tangential near it (eqs. 44-45)"
+            )?;
         }
         Ok(())
     }
