@@ -157,11 +157,12 @@ impl DamBreak {
         t * (2.0 * G / self.column_width).sqrt()
     }
 
-    /// RMS of our Z/L minus Koshizuka's at their times within our sampled range.
+    /// RMS of our Z/L minus Koshizuka's at their times within our sampled range (all of
+    /// theirs unless the run ends before t* = 3.1).
     fn toe_rms(&self) -> Option<f64> {
         let (mut sum2, mut n) = (0.0, 0);
         for (ts, z) in koshizuka() {
-            let i = self.toe.iter().position(|&(t, _)| t >= ts)?;
+            let Some(i) = self.toe.iter().position(|&(t, _)| t >= ts) else { continue };
             let ours = if i == 0 {
                 self.toe[0].1
             } else {
