@@ -12,14 +12,14 @@
 //! `centerline_v.csv` (x, v), 101 points each.
 
 use super::common::{
-    fluid_scheme, forward_to_sim, restore_sim, scheme_params, shepard, snapshot_bodies, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params, shepard,
+    snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
@@ -97,34 +97,10 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         free_surface: false,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
-    if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {
-        return Err(format!(
-            "scene `cavity`: kernel support {:.3} dx exceeds the {LAYERS} wall layers: lower `hdx` (= {})",
-            kernel.support() * h / dx,
-            p.float("hdx")
-        ));
-    }
-    let x = lattice(0.0, L, 0.0, L, dx);
-    let n = x.len();
-    let init = FluidInit {
-        u: vec![Vector::zeros(); n],
-        m: vec![RHO0 * dx * dx; n],
-        rho: vec![RHO0; n],
-        p: vec![0.0; n],
-        x,
-    };
-    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let walls = box_walls(L, L, dx, LAYERS, true);
+    check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
+    let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
-    let wall = Wall::new(
-        "wall",
-        walls.iter().map(|w| w.0).collect(),
-        walls.iter().map(|w| lid(&w.0)).collect(),
-        walls.iter().map(|w| w.1).collect(),
-        RHO0 * dx * dx,
-        RHO0,
-        C0,
-    )?;
+    let wall = wall_from(&box_walls(L, L, dx, LAYERS, true), lid, dx, RHO0, C0)?;
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
     let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };

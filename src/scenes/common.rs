@@ -5,7 +5,7 @@ use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
-use crate::solver::particles::{Fluid, Wall};
+use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::{Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName};
 use crate::solver::simulation::Simulation;
 use std::path::Path;
@@ -215,4 +215,62 @@ pub fn snapshot_bodies(
 pub fn restore_sim(sim: &mut Simulation<2>, state: &serde_json::Value) -> Result<(), String> {
     sim.restore(serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?);
     Ok(())
+}
+
+/// Refuses a kernel whose support reaches past `layers` wall layers of spacing `dx`.
+pub fn check_wall_layers(
+    scene: &str,
+    p: &Params,
+    kernel: &Kernel,
+    h: f64,
+    dx: f64,
+    layers: usize,
+) -> Result<(), String> {
+    if kernel.support() * h > layers as f64 * dx + 1e-12 {
+        return Err(format!(
+            "scene `{scene}`: kernel support {:.3} dx exceeds the {layers} wall layers: lower `hdx` (= {})",
+            kernel.support() * h / dx,
+            p.float("hdx")
+        ));
+    }
+    Ok(())
+}
+
+/// A fluid at rest on the points `x` (spacing `dx`, density `rho0`) with pressure `p(x)`.
+pub fn fluid_at_rest(
+    x: Vec<Vector<2>>,
+    dx: f64,
+    rho0: f64,
+    h: f64,
+    transport: bool,
+    p: impl Fn(&Vector<2>) -> f64,
+) -> Result<Fluid<2>, String> {
+    let n = x.len();
+    let init = FluidInit {
+        u: vec![Vector::zeros(); n],
+        m: vec![rho0 * dx * dx; n],
+        rho: vec![rho0; n],
+        p: x.iter().map(p).collect(),
+        x,
+    };
+    Fluid::new("fluid", h, init, transport)
+}
+
+/// A wall body from (position, normal) pairs with prescribed velocity `u(x)`.
+pub fn wall_from(
+    particles: &[(Vector<2>, Vector<2>)],
+    u: impl Fn(&Vector<2>) -> Vector<2>,
+    dx: f64,
+    rho0: f64,
+    c0: f64,
+) -> Result<Wall<2>, String> {
+    Wall::new(
+        "wall",
+        particles.iter().map(|w| w.0).collect(),
+        particles.iter().map(|w| u(&w.0)).collect(),
+        particles.iter().map(|w| w.1).collect(),
+        rho0 * dx * dx,
+        rho0,
+        c0,
+    )
 }

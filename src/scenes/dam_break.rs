@@ -12,7 +12,8 @@
 //! largest x of the fluid, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params,
+    snapshot_bodies, wall_from, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
@@ -20,7 +21,6 @@ use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
@@ -121,25 +121,11 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         free_surface: true,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
-    if kernel.support() * h > LAYERS as f64 * dx + 1e-12 {
-        return bad("hdx", format!("kernel support exceeds the {LAYERS} wall layers"));
-    }
-    let x = lattice(0.0, l, 0.0, hc, dx);
-    let n = x.len();
-    let p0: Vec<f64> = x.iter().map(|x| RHO0 * G * (hc - x[1])).collect();
-    let init =
-        FluidInit { u: vec![Vector::zeros(); n], m: vec![RHO0 * dx * dx; n], rho: vec![RHO0; n], p: p0, x };
-    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let walls = box_walls(tw, th, dx, LAYERS, false);
-    let wall = Wall::new(
-        "wall",
-        walls.iter().map(|w| w.0).collect(),
-        vec![Vector::zeros(); walls.len()],
-        walls.iter().map(|w| w.1).collect(),
-        RHO0 * dx * dx,
-        RHO0,
-        c0,
-    )?;
+    check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
+    let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);
+    let fluid =
+        fluid_at_rest(lattice(0.0, l, 0.0, hc, dx), dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
+    let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?;
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [tw + edge, 2.0 * th]);
     let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref, blowup_factor: 10.0 };

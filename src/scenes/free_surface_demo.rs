@@ -7,7 +7,8 @@
 //! (outer-layer particles not found).
 
 use super::common::{
-    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+    fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, wall_from,
+    FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -15,7 +16,6 @@ use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
-use crate::solver::particles::{Fluid, FluidInit, Wall};
 use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
@@ -89,28 +89,9 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         free_surface: true,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
-    let n = x.len();
-    let init = FluidInit {
-        u: vec![Vector::zeros(); n],
-        m: vec![RHO0 * dx * dx; n],
-        rho: vec![RHO0; n],
-        p: vec![0.0; n],
-        x,
-    };
-    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let wall = (!walls.is_empty())
-        .then(|| {
-            Wall::new(
-                "wall",
-                walls.iter().map(|w| w.0).collect(),
-                vec![Vector::zeros(); walls.len()],
-                walls.iter().map(|w| w.1).collect(),
-                RHO0 * dx * dx,
-                RHO0,
-                10.0,
-            )
-        })
-        .transpose()?;
+    let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
+    let wall =
+        (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
     let time = TimeSettings { cfl: p.float("cfl"), c0: 10.0, u_ref: 1.0, blowup_factor: 10.0 };
     let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time, true)
