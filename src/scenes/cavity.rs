@@ -12,8 +12,8 @@
 //! `centerline_v.csv` (x, v), 101 points each.
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params, shepard,
-    snapshot_bodies, wall_from, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
+    shepard, snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -158,13 +158,7 @@ impl Cavity {
 impl SceneRun for Cavity {
     forward_to_sim!();
     fn plan(&self) -> String {
-        let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
-        format!(
-            "body `fluid`: {} particles, h = {:.4e}; body `wall`: {w} particles ({LAYERS} layers, lid at U = {U})\n{}",
-            self.sim.fluid().len(),
-            self.sim.fluid().h,
-            self.sim.state.scheme
-        )
+        plan(&self.sim, &format!("{LAYERS} wall layers, lid at U = {U}"))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let ke = self.kinetic_energy();

@@ -187,6 +187,21 @@ macro_rules! forward_to_sim {
 }
 pub(crate) use forward_to_sim;
 
+/// The plan written at the top of a run log: the bodies (with `setting`, e.g. the walls'
+/// layout) and the scheme with every term it evaluates.
+pub fn plan(sim: &Simulation<2>, setting: &str) -> String {
+    let f = sim.fluid();
+    let walls =
+        sim.walls.as_ref().map_or(String::new(), |w| format!("; body `wall`: {} particles", w.wall.len()));
+    format!(
+        "body `fluid`: {} particles, h = {:.4e}, kernel {:?}{walls} ({setting})\n{}",
+        f.len(),
+        f.h,
+        sim.kernel.kind(),
+        sim.state.scheme
+    )
+}
+
 /// Particles in every body of `sim`.
 pub fn particle_count(sim: &Simulation<2>) -> usize {
     sim.fluid().len() + sim.walls.as_ref().map_or(0, |w| w.wall.len())

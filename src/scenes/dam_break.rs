@@ -12,7 +12,7 @@
 //! largest x of the fluid, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
     snapshot_bodies, wall_from, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
@@ -165,13 +165,7 @@ impl DamBreak {
 impl SceneRun for DamBreak {
     forward_to_sim!();
     fn plan(&self) -> String {
-        let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
-        format!(
-            "body `fluid`: {} particles, h = {:.4e}; body `wall`: {w} particles ({LAYERS} layers, open top)\n{}",
-            self.sim.fluid().len(),
-            self.sim.fluid().h,
-            self.sim.state.scheme
-        )
+        plan(&self.sim, &format!("{LAYERS} wall layers, open top"))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (t, toe) = (self.sim.time(), self.toe());

@@ -7,8 +7,8 @@
 //! (outer-layer particles not found).
 
 use super::common::{
-    fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, wall_from,
-    FluidConstants,
+    fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies,
+    wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -127,7 +127,7 @@ impl Demo {
 impl SceneRun for Demo {
     forward_to_sim!();
     fn plan(&self) -> String {
-        format!("body `fluid`: {} particles\n{}", self.sim.fluid().len(), self.sim.state.scheme)
+        plan(&self.sim, "static shape")
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (found, interior, _) = self.counts();

@@ -10,7 +10,7 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, restore_sim, scheme_params,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
     snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
@@ -118,13 +118,7 @@ impl Tank {
 impl SceneRun for Tank {
     forward_to_sim!();
     fn plan(&self) -> String {
-        let w = self.sim.walls.as_ref().map_or(0, |w| w.wall.len());
-        format!(
-            "body `fluid`: {} particles, h = {:.4e}; body `wall`: {w} particles ({LAYERS} layers, open top)\n{}",
-            self.sim.fluid().len(),
-            self.sim.fluid().h,
-            self.sim.state.scheme
-        )
+        plan(&self.sim, &format!("{LAYERS} wall layers, open top"))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (p_err, umax) = self.errors();

@@ -14,7 +14,7 @@
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
 use super::common::{
-    fluid_scheme, forward_to_sim, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+    fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -197,13 +197,7 @@ impl TaylorGreen {
 impl SceneRun for TaylorGreen {
     forward_to_sim!();
     fn plan(&self) -> String {
-        format!(
-            "body `fluid`: {} particles, h = {:.4e}, kernel {:?}, periodic unit square\n{}",
-            self.sim.fluid().len(),
-            self.sim.fluid().h,
-            self.sim.kernel.kind(),
-            self.sim.state.scheme
-        )
+        plan(&self.sim, "periodic unit square")
     }
     fn save_state(&self) -> serde_json::Value {
         serde_json::json!({ "sim": &self.sim.state, "l1_max": self.l1_max })
