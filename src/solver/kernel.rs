@@ -89,27 +89,10 @@ impl Kernel {
     #[inline(always)]
     fn shape(&self, q: f64) -> (f64, f64) {
         match self.kind {
-            KernelKind::CubicSpline => {
-                let t2 = (2.0 - q).max(0.0);
-                let t1 = (1.0 - q).max(0.0);
-                (0.25 * t2 * t2 * t2 - t1 * t1 * t1, -0.75 * t2 * t2 + 3.0 * t1 * t1)
-            }
-            KernelKind::QuinticSpline => {
-                let t3 = (3.0 - q).max(0.0);
-                let t2 = (2.0 - q).max(0.0);
-                let t1 = (1.0 - q).max(0.0);
-                let (t3_4, t2_4, t1_4) = (t3 * t3 * t3 * t3, t2 * t2 * t2 * t2, t1 * t1 * t1 * t1);
-                (t3_4 * t3 - 6.0 * t2_4 * t2 + 15.0 * t1_4 * t1, -5.0 * t3_4 + 30.0 * t2_4 - 75.0 * t1_4)
-            }
-            KernelKind::WendlandC2 => {
-                let t = (1.0 - 0.5 * q).max(0.0);
-                let t3 = t * t * t;
-                (t3 * t * (2.0 * q + 1.0), -5.0 * q * t3)
-            }
-            KernelKind::Gaussian => {
-                let e = if q < 3.0 { (-q * q).exp() } else { 0.0 };
-                (e, -2.0 * q * e)
-            }
+            KernelKind::CubicSpline => cubic_spline(q),
+            KernelKind::QuinticSpline => quintic_spline(q),
+            KernelKind::WendlandC2 => wendland_c2(q),
+            KernelKind::Gaussian => gaussian(q),
         }
     }
 
@@ -153,6 +136,39 @@ impl Kernel {
     }
 }
 
+/// Cubic spline `w(q)`, `dw/dq`.
+#[inline(always)]
+fn cubic_spline(q: f64) -> (f64, f64) {
+    let t2 = (2.0 - q).max(0.0);
+    let t1 = (1.0 - q).max(0.0);
+    (0.25 * t2 * t2 * t2 - t1 * t1 * t1, -0.75 * t2 * t2 + 3.0 * t1 * t1)
+}
+
+/// Quintic spline `w(q)`, `dw/dq`.
+#[inline(always)]
+fn quintic_spline(q: f64) -> (f64, f64) {
+    let t3 = (3.0 - q).max(0.0);
+    let t2 = (2.0 - q).max(0.0);
+    let t1 = (1.0 - q).max(0.0);
+    let (t3_4, t2_4, t1_4) = (t3 * t3 * t3 * t3, t2 * t2 * t2 * t2, t1 * t1 * t1 * t1);
+    (t3_4 * t3 - 6.0 * t2_4 * t2 + 15.0 * t1_4 * t1, -5.0 * t3_4 + 30.0 * t2_4 - 75.0 * t1_4)
+}
+
+/// Wendland C2 `w(q)`, `dw/dq`.
+#[inline(always)]
+fn wendland_c2(q: f64) -> (f64, f64) {
+    let t = (1.0 - 0.5 * q).max(0.0);
+    let t3 = t * t * t;
+    (t3 * t * (2.0 * q + 1.0), -5.0 * q * t3)
+}
+
+/// Truncated Gaussian `w(q)`, `dw/dq`.
+#[inline(always)]
+fn gaussian(q: f64) -> (f64, f64) {
+    let e = if q < 3.0 { (-q * q).exp() } else { 0.0 };
+    (e, -2.0 * q * e)
+}
+
 /// A [`Kernel`] at one smoothing length (bodies have a uniform h).
 #[derive(Clone, Copy, Debug)]
 pub struct ScaledKernel {
@@ -173,9 +189,39 @@ impl ScaledKernel {
     /// W(r) and (1/r) dW/dr (0 at r = 0), the factor that turns `x_ab` into `grad_a W_ab`.
     #[inline(always)]
     pub fn w_and_grad_factor(&self, r: f64) -> (f64, f64) {
-        let (w, dw) = self.kernel.shape(r * self.inv_h);
+        self.w_and_grad_factor_with(r, |q| self.kernel.shape(q))
+    }
+
+    #[inline(always)]
+    fn w_and_grad_factor_with(&self, r: f64, shape: impl Fn(f64) -> (f64, f64)) -> (f64, f64) {
+        let (w, dw) = shape(r * self.inv_h);
         let g = if r > 1e-12 * self.h { self.fac * dw * self.inv_h / r } else { 0.0 };
         (self.fac * w, g)
+    }
+
+    /// [`w_and_grad_factor`](Self::w_and_grad_factor) at `sqrt(r2[k])` into `out[k]`: the
+    /// neighbour lists evaluate all their pairs at once, in a loop the compiler vectorises
+    /// (the kernel's match is outside it; the values equal the one-pair call bit for bit).
+    pub fn w_and_grad_factor_batch(&self, r2: &[f64], out: &mut [(f64, f64)]) {
+        fn each(k: &ScaledKernel, r2: &[f64], out: &mut [(f64, f64)], shape: impl Fn(f64) -> (f64, f64)) {
+            for (o, &r2) in out.iter_mut().zip(r2) {
+                *o = k.w_and_grad_factor_with(r2.sqrt(), &shape);
+            }
+        }
+        match self.kernel.kind {
+            KernelKind::CubicSpline => each(self, r2, out, cubic_spline),
+            KernelKind::QuinticSpline => each(self, r2, out, quintic_spline),
+            KernelKind::WendlandC2 => each(self, r2, out, wendland_c2),
+            KernelKind::Gaussian => each(self, r2, out, gaussian),
+        }
+    }
+
+    /// [`w`](Self::w) at `sqrt(r2[k])` into `out[k]`, as
+    /// [`w_and_grad_factor_batch`](Self::w_and_grad_factor_batch).
+    pub fn w_batch(&self, r2: &[f64], out: &mut [f64]) {
+        for (o, &r2) in out.iter_mut().zip(r2) {
+            *o = self.w(r2.sqrt());
+        }
     }
 }
 
@@ -278,5 +324,21 @@ mod tests {
             assert_eq!(KernelKind::from_name(kind.name()), Some(kind));
         }
         assert_eq!(KernelKind::from_name("warp9"), None);
+    }
+
+    #[test]
+    fn batch_evaluation_equals_one_pair_evaluation_bit_for_bit() {
+        for kind in ALL {
+            let k = Kernel::new(kind, 2).scaled(0.0333);
+            let r2: Vec<f64> = (0..1000).map(|i| (i as f64 * 1.1e-4).powi(2)).collect();
+            let mut both = vec![(0.0, 0.0); r2.len()];
+            let mut w = vec![0.0; r2.len()];
+            k.w_and_grad_factor_batch(&r2, &mut both);
+            k.w_batch(&r2, &mut w);
+            for (i, &r2) in r2.iter().enumerate() {
+                assert_eq!(both[i], k.w_and_grad_factor(r2.sqrt()), "{kind:?} at r2 = {r2}");
+                assert_eq!(w[i], k.w(r2.sqrt()));
+            }
+        }
     }
 }

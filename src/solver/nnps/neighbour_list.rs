@@ -21,13 +21,33 @@ struct Chunk<const D: usize, P> {
     start: Vec<u32>,
     entries: Vec<u32>,
     payload: Vec<P>,
-    /// Scratch: the candidates around the current cell, packed, with their image
-    /// positions `x_j + shift`.
+    /// Scratch: |x_ij|^2 of the pairs whose payload is computed next.
+    r2: Vec<f64>,
+    /// Scratch: the candidates around the current cell, packed, with their positions,
     candidates: Vec<(u32, Vector<D>)>,
+    /// and the runs of them that share an image shift (one per neighbour cell).
+    runs: Vec<(usize, Vector<D>)>,
+}
+
+impl<const D: usize, P: Copy + Default> Chunk<D, P> {
+    fn clear(&mut self) {
+        self.start.clear();
+        self.entries.clear();
+        self.payload.clear();
+        self.r2.clear();
+    }
+
+    /// Closes the chunk: the payload of all its pairs from their distances.
+    fn finish(&mut self, payload: &impl Fn(&[f64], &mut [P])) {
+        self.start.push(self.entries.len() as u32);
+        self.payload.clear();
+        self.payload.resize(self.entries.len(), P::default());
+        payload(&self.r2, &mut self.payload);
+    }
 }
 
 /// For every point of a body, its neighbours within the search radius in the same body,
-/// each with a payload `P` computed from the pair at build time.
+/// each with a payload `P` computed from the pair's squared distance at build time.
 #[derive(Clone, Debug, Default)]
 pub struct NeighbourList<const D: usize, P = ()> {
     chunks: Vec<Chunk<D, P>>,
@@ -41,15 +61,17 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         Self { chunks: Vec::new(), shifts: Vec::new() }
     }
 
-    /// Lists the neighbours of every point of `points` among the same points, with
-    /// `payload(x_ij, r2)` per pair. `cells` must have binned exactly these points (in this
-    /// order: call it after [`CellList::mark_reordered`] if the points were reordered).
+    /// Lists the neighbours of every point of `points` among the same points, with their
+    /// payload: `payload(r2, out)` fills `out[k]` from the squared distance `r2[k]` of each
+    /// pair, a whole chunk of pairs at a time (so that a kernel evaluation vectorises).
+    /// `cells` must have binned exactly these points (in this order: call it after
+    /// [`CellList::mark_reordered`] if the points were reordered).
     /// Panics if the body has 2^26 points or more.
     pub fn build(
         &mut self,
         cells: &CellList<D>,
         points: &[Vector<D>],
-        payload: impl Fn(Vector<D>, f64) -> P + Sync,
+        payload: impl Fn(&[f64], &mut [P]) + Sync,
     ) {
         let n = points.len();
         assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
@@ -58,17 +80,16 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let shifts = &self.shifts;
         let r2max = cells.radius2();
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            chunk.start.clear();
-            chunk.entries.clear();
-            chunk.payload.clear();
-            // Points are visited in cell order, so the candidates of a cell (gathered with
-            // their image positions) serve every point in it.
+            chunk.clear();
+            // Points are visited in cell order, so the candidates of a cell serve every
+            // point in it.
             let mut current = usize::MAX;
             for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
                 let cell = cells.cell_of(i);
                 if cell != current {
                     current = cell;
                     chunk.candidates.clear();
+                    chunk.runs.clear();
                     cells.for_each_cell_around(cell, |indices, wraps| {
                         let mut code = 0u32;
                         for k in (0..D).rev() {
@@ -78,65 +99,68 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                             );
                             code = code * 3 + (wraps[k] + 1) as u32;
                         }
-                        let shift = shifts[code as usize];
-                        chunk.candidates.extend(
-                            indices.iter().map(|&j| (j | (code << J_BITS), points[j as usize] + shift)),
-                        );
+                        chunk.runs.push((chunk.candidates.len(), shifts[code as usize]));
+                        chunk
+                            .candidates
+                            .extend(indices.iter().map(|&j| (j | (code << J_BITS), points[j as usize])));
                     });
+                    chunk.runs.push((chunk.candidates.len(), Vector::zeros()));
                 }
                 let first = chunk.entries.len();
                 chunk.start.push(first as u32);
                 // Append every candidate, advancing the length only for neighbours: no
-                // branch on the distance test, which is unpredictable.
+                // branch on the distance test, which is unpredictable. The difference is
+                // computed as `for_each` computes it, so the payload sees the same r2.
                 let xi = points[i];
-                chunk.entries.resize(first + chunk.candidates.len(), 0);
+                let total = first + chunk.candidates.len();
+                chunk.entries.resize(total, 0);
+                chunk.r2.resize(chunk.candidates.len(), 0.0);
                 let mut len = first;
-                for &(e, xj) in &chunk.candidates {
-                    chunk.entries[len] = e;
-                    len += ((xi - xj).norm_squared() < r2max) as usize;
+                for run in chunk.runs.windows(2) {
+                    let q = xi - run[0].1;
+                    for &(e, xj) in &chunk.candidates[run[0].0..run[1].0] {
+                        let r2 = (q - xj).norm_squared();
+                        chunk.entries[len] = e;
+                        chunk.r2[len - first] = r2;
+                        len += (r2 < r2max) as usize;
+                    }
                 }
                 chunk.entries.truncate(len);
-                // The payload of the accepted pairs, in a loop without the distance branch,
-                // from the same difference `for_each` computes.
-                for &e in &chunk.entries[first..] {
-                    let xij = (xi - shifts[(e >> J_BITS) as usize]) - points[(e & J_MASK) as usize];
-                    chunk.payload.push(payload(xij, xij.norm_squared()));
-                }
+                chunk.payload.resize(len, P::default());
+                payload(&chunk.r2[..len - first], &mut chunk.payload[first..]);
             }
             chunk.start.push(chunk.entries.len() as u32);
         });
     }
 
     /// Lists, for every query point, its neighbours among `sources` (binned by `cells`),
-    /// with `payload(x_ij, r2)` per pair: the interaction of two bodies. Query points may
-    /// lie anywhere; periodic images are found as for a body's own list.
+    /// with their payload as in [`build`](Self::build): the interaction of two bodies.
+    /// Query points may lie anywhere; periodic images are found as for a body's own list.
     pub fn build_cross(
         &mut self,
         cells: &CellList<D>,
         sources: &[Vector<D>],
         queries: &[Vector<D>],
-        payload: impl Fn(Vector<D>, f64) -> P + Sync,
+        payload: impl Fn(&[f64], &mut [P]) + Sync,
     ) {
         let n = queries.len();
         assert!(sources.len() < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
         self.set_shifts(cells);
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            chunk.start.clear();
-            chunk.entries.clear();
-            chunk.payload.clear();
+            chunk.clear();
             for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
                 chunk.start.push(chunk.entries.len() as u32);
-                cells.visit(sources, &queries[i], |j, xij, r2, wraps| {
+                cells.visit(sources, &queries[i], |j, _, r2, wraps| {
                     let mut code = 0u32;
                     for k in (0..D).rev() {
                         code = code * 3 + (wraps[k].clamp(-1, 1) + 1) as u32;
                     }
                     chunk.entries.push(j as u32 | (code << J_BITS));
-                    chunk.payload.push(payload(xij, r2));
+                    chunk.r2.push(r2);
                 });
             }
-            chunk.start.push(chunk.entries.len() as u32);
+            chunk.finish(&payload);
         });
     }
 
@@ -215,7 +239,7 @@ mod tests {
             let mut cells = CellList::new(d, radius);
             cells.update(&pts);
             let mut nl = NeighbourList::<2, f64>::new();
-            nl.build(&cells, &pts, |_, r2| r2);
+            nl.build(&cells, &pts, |r2, out| out.copy_from_slice(r2));
             let brute = brute_force_neighbours(&d, radius, &pts, &pts);
             for i in 0..pts.len() {
                 let mut v = Vec::new();

@@ -28,7 +28,7 @@ pub fn build_kernel_list<const D: usize>(
     k: &Kernel,
 ) {
     let k = k.scaled(fluid.h);
-    nl.build(cells, &fluid.x, |_, r2| k.w_and_grad_factor(r2.sqrt()));
+    nl.build(cells, &fluid.x, |r2, out| k.w_and_grad_factor_batch(r2, out));
 }
 
 /// Builds the list of the neighbours of `queries` (a body of smoothing length `h`) among
@@ -42,7 +42,7 @@ pub fn build_kernel_list_cross<const D: usize>(
     k: &Kernel,
 ) {
     let k = k.scaled(h);
-    nl.build_cross(cells, sources, queries, |_, r2| k.w_and_grad_factor(r2.sqrt()));
+    nl.build_cross(cells, sources, queries, |r2, out| k.w_and_grad_factor_batch(r2, out));
 }
 
 #[inline(always)]

@@ -41,7 +41,7 @@ impl<const D: usize> WallSet<D> {
             kernel,
         );
         let k = kernel.scaled(fluid.h);
-        self.wall_to_fluid.build_cross(fluid_cells, &fluid.x, &self.wall.x, |_, r2| k.w(r2.sqrt()));
+        self.wall_to_fluid.build_cross(fluid_cells, &fluid.x, &self.wall.x, |r2, out| k.w_batch(r2, out));
     }
 
     /// Eqs. (46)-(52): the wall pressure and ghost velocities from the fluid's current
