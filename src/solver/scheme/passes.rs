@@ -97,14 +97,23 @@ impl<const D: usize> Sources<'_, D> {
     #[inline(always)]
     fn for_each(&self, i: usize, mut f: impl FnMut(&Pair<D>, &Point<D>, &Point<D>, bool)) {
         let h = self.h;
-        self.nl.for_each(i, self.x, |j, xij, r2, kw| {
-            let b = &self.pts[j];
-            f(&cached_pair(h, xij, r2, kw), b, b, true)
-        });
+        self.nl.for_each(
+            i,
+            self.x,
+            #[inline(always)]
+            |j, xij, r2, kw| {
+                let b = &self.pts[j];
+                f(&cached_pair(h, xij, r2, kw), b, b, true)
+            },
+        );
         if let Some((ws, div, visc)) = self.walls {
-            ws.fluid_to_wall.for_each_from(i, self.x[i], &ws.wall.x, |j, xij, r2, kw| {
-                f(&cached_pair(h, xij, r2, kw), &div[j], &visc[j], false)
-            });
+            ws.fluid_to_wall.for_each_from(
+                i,
+                self.x[i],
+                &ws.wall.x,
+                #[inline(always)]
+                |j, xij, r2, kw| f(&cached_pair(h, xij, r2, kw), &div[j], &visc[j], false),
+            );
         }
     }
 }
@@ -182,24 +191,16 @@ impl<const D: usize> FluidPasses<D> {
         };
         if continuity_on || edac.is_some() {
             let src = self.gather(fluid, nl, walls);
+            let terms = RateTerms { edac, pressure_corr, continuity_on, continuity_corr };
             let rate = |i: usize| -> (f64, f64) {
                 let a = &src.pts[i];
-                let (mut dp, mut drho) = (0.0, 0.0);
-                src.for_each(i, |ab, b, _, _| {
-                    if let Some((cs2, nu)) = edac {
-                        dp += edac::compressibility(a, b, ab, cs2) + edac::diffusion(a, b, ab, nu);
-                        if pressure_corr {
-                            dp += edac::transport_correction(a, b, ab);
-                        }
-                    }
-                    if continuity_on {
-                        drho += continuity::transport_divergence(a, b, ab);
-                        if continuity_corr {
-                            drho += continuity::correction(a, b, ab);
-                        }
-                    }
-                });
-                (dp, drho)
+                let mut sums = (0.0, 0.0);
+                src.for_each(
+                    i,
+                    #[inline(always)]
+                    |ab, b, _, _| terms.add(&mut sums, a, b, ab),
+                );
+                sums
             };
             match (edac.is_some(), continuity_on) {
                 (true, true) => rates
@@ -262,53 +263,23 @@ impl<const D: usize> FluidPasses<D> {
             Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
             _ => 0.0,
         };
+        let terms = AccelTerms {
+            pressure_gradient: s.pressure_gradient,
+            viscosity: s.viscosity,
+            artificial_viscosity: s.artificial_viscosity,
+            transport,
+            momentum_corr,
+            shifting,
+        };
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
             let a = &src.pts[i];
-            let mut acc = Vector::<D>::zeros();
-            let mut ac = Vector::<D>::zeros();
-            // BQL: the reference weights and the neighbour-mean pressure, combined at the end.
-            let (mut c_ref, mut p_sum, mut n_nb) = (Vector::<D>::zeros(), 0.0, 0usize);
-            src.for_each(i, |ab, b, b_visc, b_fluid| {
-                match s.pressure_gradient {
-                    PressureGradient::Symmetric { bql } => {
-                        acc += momentum::pressure_gradient(a, b, ab);
-                        if bql {
-                            c_ref += momentum::pressure_reference_weight(a, b, ab);
-                        }
-                    }
-                    PressureGradient::Adami { bql } => {
-                        acc += momentum::pressure_gradient_adami(a, b, ab);
-                        if bql {
-                            c_ref += momentum::adami_weight(a, b, ab);
-                        }
-                    }
-                }
-                p_sum += b.p;
-                n_nb += 1;
-                if let Some(nu) = s.viscosity {
-                    acc += viscosity::morris(a, b_visc, ab, nu);
-                }
-                if let Some((alpha, c)) = s.artificial_viscosity {
-                    acc += artificial_viscosity::monaghan(a, b_visc, ab, alpha, c);
-                }
-                if transport {
-                    if b_fluid {
-                        acc += momentum::artificial_stress(a, b, ab);
-                        if momentum_corr {
-                            acc += momentum::transport_divergence_correction(a, b, ab);
-                        }
-                    }
-                    match shifting {
-                        Some(Shifting::BackgroundPressure { pb }) => {
-                            ac += shifting::background_pressure(a, b, ab, pb)
-                        }
-                        Some(Shifting::Sun2019 { w_dx, r, n, .. }) => {
-                            ac += shifting::sun2019(b, ab, w_dx, r, n)
-                        }
-                        _ => {}
-                    }
-                }
-            });
+            let mut sums = AccelSums::zero();
+            src.for_each(
+                i,
+                #[inline(always)]
+                |ab, b, b_visc, b_fluid| terms.add(&mut sums, a, ab, b, b_visc, b_fluid),
+            );
+            let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
             // BQL: the gradient with the neighbour-mean pressure as reference; the mean is
             // constant over the sum, so it is applied once here (c_ref is zero without BQL).
             acc += c_ref * (p_sum / n_nb.max(1) as f64);
@@ -438,6 +409,118 @@ pub fn ipst_chi_reference<const D: usize>(
         chi.iter().fold(f64::MIN, |m, &v| m.max(v))
     } else {
         chi.iter().sum::<f64>() / chi.len() as f64
+    }
+}
+
+/// The terms of pass A a scheme declares. Their sum over one neighbour is an
+/// always-inlined method, so the per-particle sums stay in registers across the loops over
+/// the fluid and the walls.
+struct RateTerms {
+    /// EDAC's `(c_s^2, nu_edac)`, if the pressure evolves by EDAC.
+    edac: Option<(f64, f64)>,
+    pressure_corr: bool,
+    continuity_on: bool,
+    continuity_corr: bool,
+}
+
+impl RateTerms {
+    /// Adds neighbour `b`'s share of `(dp/dt, drho/dt)` of particle `a`.
+    #[inline(always)]
+    fn add<const D: usize>(&self, (dp, drho): &mut (f64, f64), a: &Point<D>, b: &Point<D>, ab: &Pair<D>) {
+        if let Some((cs2, nu)) = self.edac {
+            *dp += edac::compressibility(a, b, ab, cs2) + edac::diffusion(a, b, ab, nu);
+            if self.pressure_corr {
+                *dp += edac::transport_correction(a, b, ab);
+            }
+        }
+        if self.continuity_on {
+            *drho += continuity::transport_divergence(a, b, ab);
+            if self.continuity_corr {
+                *drho += continuity::correction(a, b, ab);
+            }
+        }
+    }
+}
+
+/// The per-particle sums of pass B.
+struct AccelSums<const D: usize> {
+    /// Acceleration.
+    acc: Vector<D>,
+    /// Homogenisation acceleration (before its prefactor).
+    ac: Vector<D>,
+    /// BQL: the weights of the reference pressure,
+    c_ref: Vector<D>,
+    /// and the neighbours' pressures and their number, for its mean.
+    p_sum: f64,
+    n_nb: usize,
+}
+
+impl<const D: usize> AccelSums<D> {
+    fn zero() -> Self {
+        Self { acc: Vector::zeros(), ac: Vector::zeros(), c_ref: Vector::zeros(), p_sum: 0.0, n_nb: 0 }
+    }
+}
+
+/// The terms of pass B a scheme declares (see [`RateTerms`] for why a struct).
+struct AccelTerms {
+    pressure_gradient: PressureGradient,
+    viscosity: Option<f64>,
+    artificial_viscosity: Option<(f64, f64)>,
+    transport: bool,
+    momentum_corr: bool,
+    shifting: Option<Shifting>,
+}
+
+impl AccelTerms {
+    /// Adds neighbour `b`'s share: `b` as the divergence terms see it, `b_visc` as the
+    /// viscous ones do (they differ for walls), `b_fluid` whether it is a fluid particle.
+    #[inline(always)]
+    fn add<const D: usize>(
+        &self,
+        s: &mut AccelSums<D>,
+        a: &Point<D>,
+        ab: &Pair<D>,
+        b: &Point<D>,
+        b_visc: &Point<D>,
+        b_fluid: bool,
+    ) {
+        match self.pressure_gradient {
+            PressureGradient::Symmetric { bql } => {
+                s.acc += momentum::pressure_gradient(a, b, ab);
+                if bql {
+                    s.c_ref += momentum::pressure_reference_weight(a, b, ab);
+                }
+            }
+            PressureGradient::Adami { bql } => {
+                s.acc += momentum::pressure_gradient_adami(a, b, ab);
+                if bql {
+                    s.c_ref += momentum::adami_weight(a, b, ab);
+                }
+            }
+        }
+        s.p_sum += b.p;
+        s.n_nb += 1;
+        if let Some(nu) = self.viscosity {
+            s.acc += viscosity::morris(a, b_visc, ab, nu);
+        }
+        if let Some((alpha, c)) = self.artificial_viscosity {
+            s.acc += artificial_viscosity::monaghan(a, b_visc, ab, alpha, c);
+        }
+        if self.transport {
+            if b_fluid {
+                s.acc += momentum::artificial_stress(a, b, ab);
+                if self.momentum_corr {
+                    s.acc += momentum::transport_divergence_correction(a, b, ab);
+                }
+            }
+            match self.shifting {
+                Some(Shifting::BackgroundPressure { pb }) => {
+                    s.ac += shifting::background_pressure(a, b, ab, pb)
+                }
+                Some(Shifting::Sun2019 { w_dx, r, n, .. }) => s.ac += shifting::sun2019(b, ab, w_dx, r, n),
+                _ => {}
+            }
+        }
     }
 }
 
