@@ -17,26 +17,50 @@ pub fn time_step(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) 
     cfl * dt
 }
 
+/// Particles per rayon task: a few flops per particle, so tasks must be long for the
+/// scheduling not to dominate at small sizes.
+const MIN_LEN: usize = 2048;
+
 /// Half kick, eq. (54) and (60): `u += dt/2 du/dt`.
-pub fn kick<const D: usize>(u: &mut [Vector<D>], du: &[Vector<D>], dt: f64) {
-    let half = 0.5 * dt;
-    u.par_iter_mut().zip(du).for_each(|(u, a)| *u += a * half);
+#[inline(always)]
+fn half_kick<const D: usize>(u: &mut Vector<D>, du: &Vector<D>, dt: f64) {
+    *u += du * (0.5 * dt);
 }
 
-/// Transport velocity at the half step, eq. (55): `u~ = u + dt/2 (du/dt)_c`.
-pub fn transport_velocity<const D: usize>(
-    u_hat: &mut [Vector<D>],
-    u: &[Vector<D>],
+/// The first half of a step, in one sweep over the particles: the half kick (eq. 54), the
+/// transport velocity `u~ = u + dt/2 (du/dt)_c` (eq. 55) if the body has one, and the drift
+/// `x += dt u~` (eq. 59).
+pub fn kick_drift<const D: usize>(
+    x: &mut [Vector<D>],
+    u: &mut [Vector<D>],
+    u_hat: Option<&mut [Vector<D>]>,
+    du: &[Vector<D>],
     a_c: &[Vector<D>],
     dt: f64,
 ) {
-    let half = 0.5 * dt;
-    u_hat.par_iter_mut().zip(u).zip(a_c).for_each(|((uh, u), ac)| *uh = u + ac * half);
+    // Zipped iterators stop at the shortest slice: every one must cover the body.
+    assert!(u.len() == x.len() && du.len() == x.len(), "one velocity and rate per particle");
+    match u_hat {
+        Some(u_hat) => {
+            assert!(u_hat.len() == x.len() && a_c.len() == x.len(), "u~ and (du/dt)_c per particle");
+            x.par_iter_mut().zip(u).zip(u_hat).zip(du).zip(a_c).with_min_len(MIN_LEN).for_each(
+                |((((x, u), uh), du), ac)| {
+                    half_kick(u, du, dt);
+                    *uh = *u + ac * (0.5 * dt);
+                    *x += *uh * dt;
+                },
+            )
+        }
+        None => x.par_iter_mut().zip(u).zip(du).with_min_len(MIN_LEN).for_each(|((x, u), du)| {
+            half_kick(u, du, dt);
+            *x += *u * dt;
+        }),
+    }
 }
 
-/// Drift, eq. (59): `x += dt u~`.
-pub fn drift<const D: usize>(x: &mut [Vector<D>], u_hat: &[Vector<D>], dt: f64) {
-    x.par_iter_mut().zip(u_hat).for_each(|(x, v)| *x += v * dt);
+/// The closing half kick of a step, eq. (60).
+pub fn kick<const D: usize>(u: &mut [Vector<D>], du: &[Vector<D>], dt: f64) {
+    u.par_iter_mut().zip(du).with_min_len(MIN_LEN).for_each(|(u, a)| half_kick(u, a, dt));
 }
 
 #[cfg(test)]

@@ -221,7 +221,7 @@ impl<const D: usize> Simulation<D> {
     /// then the wall pressure and velocities from the fluid.
     fn rebuild(&mut self) {
         let (domain, fluid) = (&self.domain, &mut self.state.fluid);
-        fluid.x.par_iter_mut().for_each(|x| domain.wrap(x));
+        fluid.x.par_iter_mut().with_min_len(2048).for_each(|x| domain.wrap(x));
         self.cells.update(&fluid.x);
         fluid.reorder(self.cells.order());
         self.cells.mark_reordered();
@@ -297,13 +297,8 @@ impl<const D: usize> Simulation<D> {
         let dt = dt_nominal.min(max_dt);
         {
             let st = &mut self.state;
-            let f = &mut st.fluid;
-            integrator::kick(&mut f.u, &st.rates.du, dt);
-            if let Some(u_hat) = f.u_hat.as_mut() {
-                integrator::transport_velocity(u_hat, &f.u, &st.rates.a_c, dt);
-            }
-            let Fluid { x, u, u_hat, .. } = f;
-            integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
+            let Fluid { x, u, u_hat, .. } = &mut st.fluid;
+            integrator::kick_drift(x, u, u_hat.as_deref_mut(), &st.rates.du, &st.rates.a_c, dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
         self.rebuild();
@@ -362,7 +357,14 @@ impl<const D: usize> Simulation<D> {
 
     /// Largest particle speed.
     pub fn max_speed(&self) -> f64 {
-        self.state.fluid.u.par_iter().map(|u| u.norm_squared()).reduce(|| 0.0, f64::max).sqrt()
+        self.state
+            .fluid
+            .u
+            .par_iter()
+            .with_min_len(2048)
+            .map(|u| u.norm_squared())
+            .reduce(|| 0.0, f64::max)
+            .sqrt()
     }
 
     /// Blow-up detection: non-finite fields, speeds beyond the bound, particles outside a
@@ -374,6 +376,7 @@ impl<const D: usize> Simulation<D> {
         // and order-independent, so the outcome does not depend on the thread count.
         let (u2, bad) = (0..f.len())
             .into_par_iter()
+            .with_min_len(2048)
             .map(|i| {
                 let ok = f.x[i].iter().all(|v| v.is_finite())
                     && f.u[i].iter().all(|v| v.is_finite())

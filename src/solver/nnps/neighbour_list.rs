@@ -115,16 +115,22 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                 let total = first + chunk.candidates.len();
                 chunk.entries.resize(total, 0);
                 chunk.r2.resize(chunk.candidates.len(), 0.0);
-                let mut len = first;
+                let (entries, r2s) = (&mut chunk.entries[first..], &mut chunk.r2[..]);
+                let mut len = 0;
                 for run in chunk.runs.windows(2) {
                     let q = xi - run[0].1;
                     for &(e, xj) in &chunk.candidates[run[0].0..run[1].0] {
                         let r2 = (q - xj).norm_squared();
-                        chunk.entries[len] = e;
-                        chunk.r2[len - first] = r2;
+                        // SAFETY: `len` counts accepted candidates among those visited, so it
+                        // is below the number of candidates, the length of both slices.
+                        unsafe {
+                            *entries.get_unchecked_mut(len) = e;
+                            *r2s.get_unchecked_mut(len) = r2;
+                        }
                         len += (r2 < r2max) as usize;
                     }
                 }
+                let len = first + len;
                 chunk.entries.truncate(len);
                 chunk.payload.resize(len, P::default());
                 payload(&chunk.r2[..len - first], &mut chunk.payload[first..]);

@@ -231,7 +231,12 @@ impl<const D: usize> FluidPasses<D> {
             PressureModel::Edac { .. } => apply(&mut fluid.p, &rates.dp, dt),
             PressureModel::StateEquation { c0, rho0 } => {
                 let c2 = c0 * c0;
-                fluid.p.par_iter_mut().zip(&fluid.rho).for_each(|(p, &rho)| *p = c2 * (rho - rho0));
+                fluid
+                    .p
+                    .par_iter_mut()
+                    .zip(&fluid.rho)
+                    .with_min_len(2048)
+                    .for_each(|(p, &rho)| *p = c2 * (rho - rho0));
             }
         }
     }
@@ -525,5 +530,5 @@ impl AccelTerms {
 }
 
 fn apply(v: &mut [f64], rate: &[f64], dt: f64) {
-    v.par_iter_mut().zip(rate).for_each(|(v, r)| *v += dt * r);
+    v.par_iter_mut().zip(rate).with_min_len(2048).for_each(|(v, r)| *v += dt * r);
 }
