@@ -189,6 +189,13 @@ fn main() -> ExitCode {
             std::process::exit(130);
         }
     });
+    // Run the command on a worker of the pool: the solver's parallel loops are then forked
+    // from inside it, without handing each one over from a thread outside the pool (which
+    // costs a sleep and a wake-up per loop: 14 % of a 2 500-particle step on 2 threads).
+    rayon::scope(|_| run(cli))
+}
+
+fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::List { preset, dirs } => {
             let code = commands::list(&dirs.dirs(), &preset);
