@@ -11,6 +11,7 @@
 
 mod brute;
 mod cell_list;
+mod filter;
 mod neighbour_list;
 
 pub use brute::brute_force_neighbours;

@@ -5,6 +5,7 @@
 //! a payload computed once per pair at build time (SPH stores the kernel value and
 //! gradient factor there: the kernel is then evaluated once per pair and step).
 
+use super::filter;
 use super::CellList;
 use crate::solver::math::Vector;
 use rayon::prelude::*;
@@ -23,10 +24,12 @@ struct Chunk<const D: usize, P> {
     payload: Vec<P>,
     /// Scratch: |x_ij|^2 of the pairs whose payload is computed next.
     r2: Vec<f64>,
-    /// Scratch: the candidates around the current cell, packed, with their positions,
-    candidates: Vec<(u32, Vector<D>)>,
-    /// and the runs of them that share an image shift (one per neighbour cell).
-    runs: Vec<(usize, Vector<D>)>,
+    /// Scratch: the candidates around the current cell, packed,
+    candidates: Vec<u32>,
+    /// with their positions and image shifts axis after axis (struct of arrays, for the
+    /// vectorised distance test).
+    candidate_x: Vec<f64>,
+    candidate_shift: Vec<f64>,
 }
 
 impl<const D: usize, P: Copy + Default> Chunk<D, P> {
@@ -35,6 +38,36 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
         self.entries.clear();
         self.payload.clear();
         self.r2.clear();
+    }
+
+    /// Gathers the candidates of the points in `cell`: the points of the 3^D cells around
+    /// it, with the image shifts they are seen through.
+    fn gather_candidates(
+        &mut self,
+        cells: &CellList<D>,
+        cell: usize,
+        points: &[Vector<D>],
+        shifts: &[Vector<D>],
+    ) {
+        self.candidates.clear();
+        cells.for_each_cell_around(cell, |indices, wraps| {
+            let mut code = 0u32;
+            for k in (0..D).rev() {
+                debug_assert!((-1..=1).contains(&wraps[k]), "self-queries wrap by one period at most");
+                code = code * 3 + (wraps[k] + 1) as u32;
+            }
+            self.candidates.extend(indices.iter().map(|&j| j | (code << J_BITS)));
+        });
+        let m = self.candidates.len();
+        self.candidate_x.resize(D * m, 0.0);
+        self.candidate_shift.resize(D * m, 0.0);
+        for (k, &e) in self.candidates.iter().enumerate() {
+            let (x, s) = (&points[(e & J_MASK) as usize], &shifts[(e >> J_BITS) as usize]);
+            for d in 0..D {
+                self.candidate_x[d * m + k] = x[d];
+                self.candidate_shift[d * m + k] = s[d];
+            }
+        }
     }
 
     /// Closes the chunk: the payload of all its pairs from their distances.
@@ -79,6 +112,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         let shifts = &self.shifts;
         let r2max = cells.radius2();
+        let simd = filter::simd_available();
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
             chunk.clear();
             // Points are visited in cell order, so the candidates of a cell serve every
@@ -88,49 +122,22 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                 let cell = cells.cell_of(i);
                 if cell != current {
                     current = cell;
-                    chunk.candidates.clear();
-                    chunk.runs.clear();
-                    cells.for_each_cell_around(cell, |indices, wraps| {
-                        let mut code = 0u32;
-                        for k in (0..D).rev() {
-                            debug_assert!(
-                                (-1..=1).contains(&wraps[k]),
-                                "self-queries wrap by one period at most"
-                            );
-                            code = code * 3 + (wraps[k] + 1) as u32;
-                        }
-                        chunk.runs.push((chunk.candidates.len(), shifts[code as usize]));
-                        chunk
-                            .candidates
-                            .extend(indices.iter().map(|&j| (j | (code << J_BITS), points[j as usize])));
-                    });
-                    chunk.runs.push((chunk.candidates.len(), Vector::zeros()));
+                    chunk.gather_candidates(cells, cell, points, shifts);
                 }
                 let first = chunk.entries.len();
                 chunk.start.push(first as u32);
-                // Append every candidate, advancing the length only for neighbours: no
-                // branch on the distance test, which is unpredictable. The difference is
-                // computed as `for_each` computes it, so the payload sees the same r2.
-                let xi = points[i];
-                let total = first + chunk.candidates.len();
-                chunk.entries.resize(total, 0);
-                chunk.r2.resize(chunk.candidates.len(), 0.0);
-                let (entries, r2s) = (&mut chunk.entries[first..], &mut chunk.r2[..]);
-                let mut len = 0;
-                for run in chunk.runs.windows(2) {
-                    let q = xi - run[0].1;
-                    for &(e, xj) in &chunk.candidates[run[0].0..run[1].0] {
-                        let r2 = (q - xj).norm_squared();
-                        // SAFETY: `len` counts accepted candidates among those visited, so it
-                        // is below the number of candidates, the length of both slices.
-                        unsafe {
-                            *entries.get_unchecked_mut(len) = e;
-                            *r2s.get_unchecked_mut(len) = r2;
-                        }
-                        len += (r2 < r2max) as usize;
-                    }
-                }
-                let len = first + len;
+                let m = chunk.candidates.len();
+                // Room for every candidate plus one vector of lanes past the last.
+                chunk.entries.resize(first + m + filter::LANES, 0);
+                chunk.r2.resize(m + filter::LANES, 0.0);
+                let c = filter::Candidates {
+                    entries: &chunk.candidates,
+                    x: &chunk.candidate_x,
+                    shift: &chunk.candidate_shift,
+                };
+                let accepted =
+                    filter::within(simd, &points[i], &c, r2max, &mut chunk.entries[first..], &mut chunk.r2);
+                let len = first + accepted;
                 chunk.entries.truncate(len);
                 chunk.payload.resize(len, P::default());
                 payload(&chunk.r2[..len - first], &mut chunk.payload[first..]);
