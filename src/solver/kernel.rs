@@ -219,8 +219,17 @@ impl ScaledKernel {
     /// [`w`](Self::w) at `sqrt(r2[k])` into `out[k]`, as
     /// [`w_and_grad_factor_batch`](Self::w_and_grad_factor_batch).
     pub fn w_batch(&self, r2: &[f64], out: &mut [f64]) {
-        for (o, &r2) in out.iter_mut().zip(r2) {
-            *o = self.w(r2.sqrt());
+        #[inline(always)]
+        fn each(k: &ScaledKernel, r2: &[f64], out: &mut [f64], shape: impl Fn(f64) -> (f64, f64)) {
+            for (o, &r2) in out.iter_mut().zip(r2) {
+                *o = k.fac * shape(r2.sqrt() * k.inv_h).0;
+            }
+        }
+        match self.kernel.kind {
+            KernelKind::CubicSpline => each(self, r2, out, cubic_spline),
+            KernelKind::QuinticSpline => each(self, r2, out, quintic_spline),
+            KernelKind::WendlandC2 => each(self, r2, out, wendland_c2),
+            KernelKind::Gaussian => each(self, r2, out, gaussian),
         }
     }
 }

@@ -46,12 +46,6 @@ pub fn build_kernel_list_cross<const D: usize>(
 }
 
 #[inline(always)]
-fn pair<const D: usize>(k: &ScaledKernel, xij: Vector<D>, r2: f64) -> Pair<D> {
-    let (w, f) = k.w_and_grad_factor(r2.sqrt());
-    Pair::new(xij, r2, k.h, w, f)
-}
-
-#[inline(always)]
 fn cached_pair<const D: usize>(h: f64, xij: Vector<D>, r2: f64, &(w, f): &(f64, f64)) -> Pair<D> {
     Pair::new(xij, r2, h, w, f)
 }
@@ -123,7 +117,7 @@ impl<const D: usize> Sources<'_, D> {
 #[derive(Clone, Debug, Default)]
 pub struct FluidPasses<const D: usize> {
     x_shift: Vec<Vector<D>>,
-    dr: Vec<Vector<D>>,
+    x_next: Vec<Vector<D>>,
     chi: Vec<f64>,
     points: Vec<Point<D>>,
     wall_div: Vec<Point<D>>,
@@ -342,42 +336,52 @@ impl<const D: usize> FluidPasses<D> {
         let n = fluid.len();
         self.x_shift.clear();
         self.x_shift.extend_from_slice(&fluid.x);
-        self.dr.resize(n, Vector::zeros());
+        self.x_next.resize(n, Vector::zeros());
         self.chi.resize(n, 0.0);
         // The volumes gathered by `accelerations` at these positions.
         let (pts, wall_pts) = (&self.points, &self.wall_div);
         let mut iterations = 0;
         while iterations < max_iter {
+            // One sweep: chi at the current positions (eq. 40) and the moved positions
+            // (eq. 37) into a second buffer, used if chi has not converged.
             let xs: &[Vector<D>] = &self.x_shift;
-            self.dr.par_iter_mut().zip(self.chi.par_iter_mut()).enumerate().with_min_len(MIN_LEN).for_each(
-                |(i, (dr, chi))| {
-                    let (mut d, mut x) = (Vector::<D>::zeros(), 0.0);
-                    let mut add = |ab: &Pair<D>, b: &Point<D>| {
-                        d += shifting::ipst_displacement(b, ab);
-                        x += shifting::ipst_chi(ab);
-                    };
-                    nl.for_each(i, xs, |j, xij, r2, _| add(&pair(&k, xij, r2), &pts[j]));
+            self.x_next
+                .par_iter_mut()
+                .zip(self.chi.par_iter_mut())
+                .enumerate()
+                .with_min_len(MIN_LEN)
+                .for_each(|(i, (next, chi))| {
+                    let mut sums = IpstSums::new(k);
+                    nl.for_each(
+                        i,
+                        xs,
+                        #[inline(always)]
+                        |j, xij, r2, _| sums.push(xij, r2, pts[j].v()),
+                    );
                     if let Some(ws) = walls {
-                        ws.fluid_to_wall.for_each_from(i, xs[i], &ws.wall.x, |j, xij, r2, _| {
-                            add(&pair(&k, xij, r2), &wall_pts[j])
-                        });
+                        ws.fluid_to_wall.for_each_from(
+                            i,
+                            xs[i],
+                            &ws.wall.x,
+                            #[inline(always)]
+                            |j, xij, r2, _| sums.push(xij, r2, wall_pts[j].v()),
+                        );
                     }
-                    *dr = d * (u_max * dt);
+                    let (d, x) = sums.finish();
+                    let mut dr = d * (u_max * dt);
                     if let Some(fs) = surface {
                         // eq. (45)
-                        *dr = free_surface::adjust_shift(*dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                        dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
                     }
                     *chi = x;
-                },
-            );
+                    // Not wrapped: the list's image shifts refer to the unwrapped positions.
+                    *next = xs[i] + dr;
+                });
             let chi_max = self.chi.iter().fold(f64::MIN, |m, &v| m.max(v));
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
                 break;
             }
-            // Not wrapped: the list's image shifts refer to the unwrapped positions.
-            for (x, dr) in self.x_shift.iter_mut().zip(&self.dr) {
-                *x += dr;
-            }
+            std::mem::swap(&mut self.x_shift, &mut self.x_next);
             iterations += 1;
         }
         let f = 2.0 / (dt * dt);
@@ -386,6 +390,72 @@ impl<const D: usize> FluidPasses<D> {
             *ac = (xs[i] - x0[i]) * f;
         });
         iterations
+    }
+}
+
+/// Neighbours per kernel evaluation in the IPST sums.
+const IPST_BLOCK: usize = 16;
+
+/// One particle's IPST sums, eqs. (37) and (40), over its neighbours at moved positions.
+/// The neighbours are buffered and the kernel evaluated for a block of them at once
+/// (vectorised); they are summed in the order they were pushed.
+struct IpstSums<const D: usize> {
+    k: ScaledKernel,
+    len: usize,
+    xij: [Vector<D>; IPST_BLOCK],
+    r2: [f64; IPST_BLOCK],
+    vol: [f64; IPST_BLOCK],
+    w: [f64; IPST_BLOCK],
+    displacement: Vector<D>,
+    chi: f64,
+}
+
+impl<const D: usize> IpstSums<D> {
+    fn new(k: ScaledKernel) -> Self {
+        Self {
+            k,
+            len: 0,
+            xij: [Vector::zeros(); IPST_BLOCK],
+            r2: [0.0; IPST_BLOCK],
+            vol: [0.0; IPST_BLOCK],
+            w: [0.0; IPST_BLOCK],
+            displacement: Vector::zeros(),
+            chi: 0.0,
+        }
+    }
+
+    /// Adds the neighbour at `xij` (`r2 = |xij|^2`) of volume `vol`.
+    #[inline(always)]
+    fn push(&mut self, xij: Vector<D>, r2: f64, vol: f64) {
+        let l = self.len;
+        self.xij[l] = xij;
+        self.r2[l] = r2;
+        self.vol[l] = vol;
+        self.len += 1;
+        if self.len == IPST_BLOCK {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        let l = self.len;
+        self.k.w_batch(&self.r2[..l], &mut self.w[..l]);
+        // The weights in a loop of their own (it vectorises), then the sums in order.
+        let mut f = [0.0; IPST_BLOCK];
+        for m in 0..l {
+            f[m] = shifting::ipst_weight(self.vol[m], self.w[m], self.r2[m]);
+        }
+        for m in 0..l {
+            self.displacement += self.xij[m] * f[m];
+            self.chi += shifting::ipst_chi(&Pair::new(self.xij[m], self.r2[m], self.k.h, self.w[m], 0.0));
+        }
+        self.len = 0;
+    }
+
+    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
+    fn finish(mut self) -> (Vector<D>, f64) {
+        self.flush();
+        (self.displacement, self.chi)
     }
 }
 
