@@ -218,6 +218,31 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
+    /// Appends the neighbours of query point `i` at `xi` to `j`, their differences `x_ij`
+    /// to `xij` and `|x_ij|^2` to `r2`, as [`for_each_from`](Self::for_each_from) visits
+    /// them: the pairs as arrays, for passes that evaluate them in vectorised loops.
+    pub fn append_pairs(
+        &self,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        j: &mut Vec<u32>,
+        xij: &mut Vec<Vector<D>>,
+        r2: &mut Vec<f64>,
+    ) {
+        self.for_each_from(
+            i,
+            xi,
+            points,
+            #[inline(always)]
+            |jj, x, rr, _| {
+                j.push(jj as u32);
+                xij.push(x);
+                r2.push(rr);
+            },
+        );
+    }
+
     /// Total number of (ordered) pairs.
     pub fn pairs(&self) -> usize {
         self.chunks.iter().map(|c| c.entries.len()).sum()

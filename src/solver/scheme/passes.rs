@@ -350,24 +350,8 @@ impl<const D: usize> FluidPasses<D> {
                 .zip(self.chi.par_iter_mut())
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, (next, chi))| {
-                    let mut sums = IpstSums::new(k);
-                    nl.for_each(
-                        i,
-                        xs,
-                        #[inline(always)]
-                        |j, xij, r2, _| sums.push(xij, r2, pts[j].v()),
-                    );
-                    if let Some(ws) = walls {
-                        ws.fluid_to_wall.for_each_from(
-                            i,
-                            xs[i],
-                            &ws.wall.x,
-                            #[inline(always)]
-                            |j, xij, r2, _| sums.push(xij, r2, wall_pts[j].v()),
-                        );
-                    }
-                    let (d, x) = sums.finish();
+                .for_each_init(IpstPairs::default, |pairs, (i, (next, chi))| {
+                    let (d, x) = pairs.sums(i, xs, nl, pts, walls.map(|ws| (ws, &wall_pts[..])), &k);
                     let mut dr = d * (u_max * dt);
                     if let Some(fs) = surface {
                         // eq. (45)
@@ -393,69 +377,55 @@ impl<const D: usize> FluidPasses<D> {
     }
 }
 
-/// Neighbours per kernel evaluation in the IPST sums.
-const IPST_BLOCK: usize = 16;
-
-/// One particle's IPST sums, eqs. (37) and (40), over its neighbours at moved positions.
-/// The neighbours are buffered and the kernel evaluated for a block of them at once
-/// (vectorised); they are summed in the order they were pushed.
-struct IpstSums<const D: usize> {
-    k: ScaledKernel,
-    len: usize,
-    xij: [Vector<D>; IPST_BLOCK],
-    r2: [f64; IPST_BLOCK],
-    vol: [f64; IPST_BLOCK],
-    w: [f64; IPST_BLOCK],
-    displacement: Vector<D>,
-    chi: f64,
+/// One particle's pairs at moved positions, as arrays (reused from particle to particle),
+/// for the IPST sums of eqs. (37) and (40): the kernel and the weights are evaluated for
+/// all the pairs at once in vectorised loops, then summed in the neighbour order.
+#[derive(Default)]
+struct IpstPairs<const D: usize> {
+    j: Vec<u32>,
+    xij: Vec<Vector<D>>,
+    r2: Vec<f64>,
+    vol: Vec<f64>,
+    w: Vec<f64>,
+    weight: Vec<f64>,
 }
 
-impl<const D: usize> IpstSums<D> {
-    fn new(k: ScaledKernel) -> Self {
-        Self {
-            k,
-            len: 0,
-            xij: [Vector::zeros(); IPST_BLOCK],
-            r2: [0.0; IPST_BLOCK],
-            vol: [0.0; IPST_BLOCK],
-            w: [0.0; IPST_BLOCK],
-            displacement: Vector::zeros(),
-            chi: 0.0,
+impl<const D: usize> IpstPairs<D> {
+    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)` of particle `i` at positions `xs`, over the
+    /// fluid (volumes `pts`) and the walls (with theirs).
+    fn sums(
+        &mut self,
+        i: usize,
+        xs: &[Vector<D>],
+        nl: &KernelList<D>,
+        pts: &[Point<D>],
+        walls: Option<(&WallSet<D>, &[Point<D>])>,
+        k: &ScaledKernel,
+    ) -> (Vector<D>, f64) {
+        self.j.clear();
+        self.xij.clear();
+        self.r2.clear();
+        self.vol.clear();
+        nl.append_pairs(i, xs[i], xs, &mut self.j, &mut self.xij, &mut self.r2);
+        self.vol.extend(self.j.iter().map(|&j| pts[j as usize].v()));
+        if let Some((ws, wall_pts)) = walls {
+            let from = self.j.len();
+            ws.fluid_to_wall.append_pairs(i, xs[i], &ws.wall.x, &mut self.j, &mut self.xij, &mut self.r2);
+            self.vol.extend(self.j[from..].iter().map(|&j| wall_pts[j as usize].v()));
         }
-    }
-
-    /// Adds the neighbour at `xij` (`r2 = |xij|^2`) of volume `vol`.
-    #[inline(always)]
-    fn push(&mut self, xij: Vector<D>, r2: f64, vol: f64) {
-        let l = self.len;
-        self.xij[l] = xij;
-        self.r2[l] = r2;
-        self.vol[l] = vol;
-        self.len += 1;
-        if self.len == IPST_BLOCK {
-            self.flush();
+        let n = self.r2.len();
+        self.w.resize(n, 0.0);
+        self.weight.resize(n, 0.0);
+        k.w_batch(&self.r2, &mut self.w);
+        for (((f, &v), &w), &r2) in self.weight.iter_mut().zip(&self.vol).zip(&self.w).zip(&self.r2) {
+            *f = shifting::ipst_weight(v, w, r2);
         }
-    }
-
-    fn flush(&mut self) {
-        let l = self.len;
-        self.k.w_batch(&self.r2[..l], &mut self.w[..l]);
-        // The weights in a loop of their own (it vectorises), then the sums in order.
-        let mut f = [0.0; IPST_BLOCK];
-        for m in 0..l {
-            f[m] = shifting::ipst_weight(self.vol[m], self.w[m], self.r2[m]);
+        let (mut d, mut chi) = (Vector::<D>::zeros(), 0.0);
+        for m in 0..n {
+            d += self.xij[m] * self.weight[m];
+            chi += shifting::ipst_chi(&Pair::new(self.xij[m], self.r2[m], k.h, self.w[m], 0.0));
         }
-        for m in 0..l {
-            self.displacement += self.xij[m] * f[m];
-            self.chi += shifting::ipst_chi(&Pair::new(self.xij[m], self.r2[m], self.k.h, self.w[m], 0.0));
-        }
-        self.len = 0;
-    }
-
-    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
-    fn finish(mut self) -> (Vector<D>, f64) {
-        self.flush();
-        (self.displacement, self.chi)
+        (d, chi)
     }
 }
 
