@@ -139,8 +139,14 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                     filter::within(simd, &points[i], &c, r2max, &mut chunk.entries[first..], &mut chunk.r2);
                 let len = first + accepted;
                 chunk.entries.truncate(len);
-                chunk.payload.resize(len, P::default());
-                payload(&chunk.r2[..len - first], &mut chunk.payload[first..]);
+                // The payload over whole vectors: the pairs padded with copies of the search
+                // radius, whose values are then dropped (a scalar tail loop would cost as
+                // much as the vector body).
+                let padded = accepted.next_multiple_of(filter::LANES);
+                chunk.r2[accepted..padded].fill(r2max);
+                chunk.payload.resize(first + padded, P::default());
+                payload(&chunk.r2[..padded], &mut chunk.payload[first..]);
+                chunk.payload.truncate(len);
             }
             chunk.start.push(chunk.entries.len() as u32);
         });

@@ -413,9 +413,13 @@ impl<const D: usize> IpstPairs<D> {
             ws.fluid_to_wall.append_pairs(i, xs[i], &ws.wall.x, &mut self.j, &mut self.xij, &mut self.r2);
             self.vol.extend(self.j[from..].iter().map(|&j| wall_pts[j as usize].v()));
         }
+        // Whole vectors for the batch loops (no scalar tail): pad, then ignore the padding.
         let n = self.r2.len();
-        self.w.resize(n, 0.0);
-        self.weight.resize(n, 0.0);
+        let padded = n.next_multiple_of(8);
+        self.r2.resize(padded, 0.0);
+        self.vol.resize(padded, 0.0);
+        self.w.resize(padded, 0.0);
+        self.weight.resize(padded, 0.0);
         k.w_batch(&self.r2, &mut self.w);
         for (((f, &v), &w), &r2) in self.weight.iter_mut().zip(&self.vol).zip(&self.w).zip(&self.r2) {
             *f = shifting::ipst_weight(v, w, r2);
