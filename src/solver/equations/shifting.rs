@@ -52,10 +52,11 @@ pub fn ipst_weight(v_b: f64, w: f64, r2: f64) -> f64 {
     }
 }
 
-/// The IPST uniformity measure of eq. (40), one neighbour's share: `h^2 W_ab`.
+/// The IPST uniformity measure of eq. (40), one neighbour's share: `h^2 W_ab` (on
+/// scalars, as [`ipst_weight`]).
 #[inline(always)]
-pub fn ipst_chi<const D: usize>(ab: &Pair<D>) -> f64 {
-    ab.h * ab.h * ab.wij
+pub fn ipst_chi(h: f64, w: f64) -> f64 {
+    h * h * w
 }
 
 #[cfg(test)]

@@ -421,13 +421,16 @@ impl<const D: usize> IpstPairs<D> {
         self.w.resize(padded, 0.0);
         self.weight.resize(padded, 0.0);
         k.w_batch(&self.r2, &mut self.w);
-        for (((f, &v), &w), &r2) in self.weight.iter_mut().zip(&self.vol).zip(&self.w).zip(&self.r2) {
-            *f = shifting::ipst_weight(v, w, r2);
+        // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
+        for (((f, &v), w), &r2) in self.weight.iter_mut().zip(&self.vol).zip(self.w.iter_mut()).zip(&self.r2)
+        {
+            *f = shifting::ipst_weight(v, *w, r2);
+            *w = shifting::ipst_chi(k.h, *w);
         }
         let (mut d, mut chi) = (Vector::<D>::zeros(), 0.0);
         for m in 0..n {
             d += self.xij[m] * self.weight[m];
-            chi += shifting::ipst_chi(&Pair::new(self.xij[m], self.r2[m], k.h, self.w[m], 0.0));
+            chi += self.w[m];
         }
         (d, chi)
     }
@@ -445,8 +448,7 @@ pub fn ipst_chi_reference<const D: usize>(
     let chi: Vec<f64> = (0..fluid.len())
         .map(|i| {
             let mut s = 0.0;
-            let mut add =
-                |xij, r2, kw: (f64, f64)| s += shifting::ipst_chi(&cached_pair(fluid.h, xij, r2, &kw));
+            let mut add = |_, _, kw: (f64, f64)| s += shifting::ipst_chi(fluid.h, kw.0);
             nl.for_each(i, &fluid.x, |_, xij, r2, &kw| add(xij, r2, kw));
             if let Some(ws) = walls {
                 ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, xij, r2, &kw| add(xij, r2, kw));
