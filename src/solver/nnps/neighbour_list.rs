@@ -236,17 +236,22 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         xij: &mut Vec<Vector<D>>,
         r2: &mut Vec<f64>,
     ) {
-        self.for_each_from(
-            i,
-            xi,
-            points,
-            #[inline(always)]
-            |jj, x, rr, _| {
-                j.push(jj as u32);
-                xij.push(x);
-                r2.push(rr);
-            },
-        );
+        let chunk = &self.chunks[i / CHUNK];
+        let l = i % CHUNK;
+        let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
+        // Sized first and written in place: pushes would check the capacity per pair.
+        let from = j.len();
+        let to = from + entries.len();
+        j.resize(to, 0);
+        xij.resize(to, Vector::zeros());
+        r2.resize(to, 0.0);
+        for (((&e, j), xij), r2) in
+            entries.iter().zip(&mut j[from..]).zip(&mut xij[from..]).zip(&mut r2[from..])
+        {
+            *j = e & J_MASK;
+            *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[*j as usize];
+            *r2 = xij.norm_squared();
+        }
     }
 
     /// Total number of (ordered) pairs.
