@@ -169,6 +169,31 @@ fn gaussian(q: f64) -> (f64, f64) {
     (e, -2.0 * q * e)
 }
 
+/// Evaluates `$body` with `$shape` bound to the shape function of kernel kind `$kind`: the
+/// match is taken once, outside the loop `$body` holds, which then vectorises.
+macro_rules! with_shape {
+    ($kind:expr, $shape:ident => $body:expr) => {
+        match $kind {
+            KernelKind::CubicSpline => {
+                let $shape = cubic_spline;
+                $body
+            }
+            KernelKind::QuinticSpline => {
+                let $shape = quintic_spline;
+                $body
+            }
+            KernelKind::WendlandC2 => {
+                let $shape = wendland_c2;
+                $body
+            }
+            KernelKind::Gaussian => {
+                let $shape = gaussian;
+                $body
+            }
+        }
+    };
+}
+
 /// A [`Kernel`] at one smoothing length (bodies have a uniform h).
 #[derive(Clone, Copy, Debug)]
 pub struct ScaledKernel {
@@ -203,34 +228,21 @@ impl ScaledKernel {
     /// neighbour lists evaluate all their pairs at once, in a loop the compiler vectorises
     /// (the kernel's match is outside it; the values equal the one-pair call bit for bit).
     pub fn w_and_grad_factor_batch(&self, r2: &[f64], out: &mut [(f64, f64)]) {
-        fn each(k: &ScaledKernel, r2: &[f64], out: &mut [(f64, f64)], shape: impl Fn(f64) -> (f64, f64)) {
+        with_shape!(self.kernel.kind, shape => {
             for (o, &r2) in out.iter_mut().zip(r2) {
-                *o = k.w_and_grad_factor_with(r2.sqrt(), &shape);
+                *o = self.w_and_grad_factor_with(r2.sqrt(), shape);
             }
-        }
-        match self.kernel.kind {
-            KernelKind::CubicSpline => each(self, r2, out, cubic_spline),
-            KernelKind::QuinticSpline => each(self, r2, out, quintic_spline),
-            KernelKind::WendlandC2 => each(self, r2, out, wendland_c2),
-            KernelKind::Gaussian => each(self, r2, out, gaussian),
-        }
+        })
     }
 
     /// [`w`](Self::w) at `sqrt(r2[k])` into `out[k]`, as
     /// [`w_and_grad_factor_batch`](Self::w_and_grad_factor_batch).
     pub fn w_batch(&self, r2: &[f64], out: &mut [f64]) {
-        #[inline(always)]
-        fn each(k: &ScaledKernel, r2: &[f64], out: &mut [f64], shape: impl Fn(f64) -> (f64, f64)) {
+        with_shape!(self.kernel.kind, shape => {
             for (o, &r2) in out.iter_mut().zip(r2) {
-                *o = k.fac * shape(r2.sqrt() * k.inv_h).0;
+                *o = self.fac * shape(r2.sqrt() * self.inv_h).0;
             }
-        }
-        match self.kernel.kind {
-            KernelKind::CubicSpline => each(self, r2, out, cubic_spline),
-            KernelKind::QuinticSpline => each(self, r2, out, quintic_spline),
-            KernelKind::WendlandC2 => each(self, r2, out, wendland_c2),
-            KernelKind::Gaussian => each(self, r2, out, gaussian),
-        }
+        })
     }
 }
 
