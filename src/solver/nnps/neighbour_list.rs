@@ -76,6 +76,20 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
         self.payload.clear();
         self.payload.resize(self.entries.len(), P::default());
         payload(&self.r2, &mut self.payload);
+        self.keep_headroom();
+    }
+
+    /// Keeps room for a quarter more pairs than this build found (plus the scratch a point
+    /// needs), so that the next builds, whose pair counts differ by a few per cent, do not
+    /// allocate: a step allocates nothing once the lists have grown (tested).
+    fn keep_headroom(&mut self) {
+        let want = self.entries.len() + self.entries.len() / 4 + 256;
+        if self.entries.capacity() < want {
+            self.entries.reserve(want - self.entries.len());
+        }
+        if self.payload.capacity() < want {
+            self.payload.reserve(want - self.payload.len());
+        }
     }
 }
 
@@ -149,6 +163,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                 chunk.payload.truncate(len);
             }
             chunk.start.push(chunk.entries.len() as u32);
+            chunk.keep_headroom();
         });
     }
 

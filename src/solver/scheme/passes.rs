@@ -118,6 +118,7 @@ impl<const D: usize> Sources<'_, D> {
 pub struct FluidPasses<const D: usize> {
     x_shift: Vec<Vector<D>>,
     x_next: Vec<Vector<D>>,
+    ipst_pairs: Vec<IpstPairs<D>>,
     chi: Vec<f64>,
     points: Vec<Point<D>>,
     wall_div: Vec<Point<D>>,
@@ -345,21 +346,27 @@ impl<const D: usize> FluidPasses<D> {
             // One sweep: chi at the current positions (eq. 40) and the moved positions
             // (eq. 37) into a second buffer, used if chi has not converged.
             let xs: &[Vector<D>] = &self.x_shift;
+            // In fixed blocks of particles, each with its own pair arrays kept from step to
+            // step (so that the sweeps allocate nothing once they have grown).
+            self.ipst_pairs.resize_with(n.div_ceil(MIN_LEN), IpstPairs::default);
             self.x_next
-                .par_iter_mut()
-                .zip(self.chi.par_iter_mut())
+                .par_chunks_mut(MIN_LEN)
+                .zip(self.chi.par_chunks_mut(MIN_LEN))
+                .zip(self.ipst_pairs.par_iter_mut())
                 .enumerate()
-                .with_min_len(MIN_LEN)
-                .for_each_init(IpstPairs::default, |pairs, (i, (next, chi))| {
-                    let (d, x) = pairs.sums(i, xs, nl, pts, walls.map(|ws| (ws, &wall_pts[..])), &k);
-                    let mut dr = d * (u_max * dt);
-                    if let Some(fs) = surface {
-                        // eq. (45)
-                        dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                .for_each(|(c, ((next, chi), pairs))| {
+                    for (l, (next, chi)) in next.iter_mut().zip(chi.iter_mut()).enumerate() {
+                        let i = c * MIN_LEN + l;
+                        let (d, x) = pairs.sums(i, xs, nl, pts, walls.map(|ws| (ws, &wall_pts[..])), &k);
+                        let mut dr = d * (u_max * dt);
+                        if let Some(fs) = surface {
+                            // eq. (45)
+                            dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                        }
+                        *chi = x;
+                        // Not wrapped: the list's image shifts refer to the unwrapped positions.
+                        *next = xs[i] + dr;
                     }
-                    *chi = x;
-                    // Not wrapped: the list's image shifts refer to the unwrapped positions.
-                    *next = xs[i] + dr;
                 });
             let chi_max = self.chi.iter().fold(f64::MIN, |m, &v| m.max(v));
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
@@ -380,7 +387,7 @@ impl<const D: usize> FluidPasses<D> {
 /// One particle's pairs at moved positions, as arrays (reused from particle to particle),
 /// for the IPST sums of eqs. (37) and (40): the kernel and the weights are evaluated for
 /// all the pairs at once in vectorised loops, then summed in the neighbour order.
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 struct IpstPairs<const D: usize> {
     j: Vec<u32>,
     xij: Vec<Vector<D>>,

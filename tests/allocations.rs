@@ -1,0 +1,69 @@
+//! Once warmed up, a time step allocates nothing: every pass and the neighbour search reuse
+//! their buffers (STYLE 6.11). Counted with a global allocator over whole steps, on a pool of
+//! two threads as the binary runs them. One test function, because the count is global to
+//! the test binary.
+
+use sphrepro::scenes::{self, SceneEntry};
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator, only counting.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.alloc(layout)
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        System.dealloc(ptr, layout)
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        System.realloc(ptr, layout, new_size)
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+/// Allocations made by steps `warm + 1 ..= warm + steps` of `scene` with `sets`.
+fn allocations_per_run(entry: &SceneEntry, sets: &[&str], warm: u64, steps: u64) -> usize {
+    let params = entry.params_from_sets(&sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap();
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+    pool.install(|| {
+        let mut run = (entry.build)(&params).unwrap();
+        let mut start = 0;
+        let mut counted = None;
+        run.advance(1e9, 1e9, &mut |_, n| {
+            if n == warm {
+                start = ALLOCATIONS.load(Ordering::SeqCst);
+            }
+            if n == warm + steps {
+                counted = Some(ALLOCATIONS.load(Ordering::SeqCst) - start);
+                return false;
+            }
+            true
+        })
+        .unwrap();
+        counted.expect("the run reached the counted steps")
+    })
+}
+
+#[test]
+fn steps_allocate_nothing_once_warm() {
+    let cases: &[(&SceneEntry, &[&str])] = &[
+        (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=edac"]),
+        (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=ctvf", "pst=sun"]),
+        (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=ctvf", "pst=ipst"]),
+        (scenes::find("cavity").unwrap(), &["nx=20"]),
+        (scenes::find("hydrostatic_tank").unwrap(), &["dx=0.1"]),
+        (scenes::find("dam_break").unwrap(), &["dx=0.1", "pst=ipst"]),
+    ];
+    for (entry, sets) in cases {
+        let n = allocations_per_run(entry, sets, 30, 40);
+        assert_eq!(n, 0, "{} {sets:?}: {n} allocations in 40 steps", entry.name);
+    }
+}
