@@ -73,7 +73,7 @@ fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
 
 /// Reads columns `x` and `y` of a CSV file (unparsable values are NaN).
 fn columns(path: &Path, x: &str, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
-    let mut rd = csv::Reader::from_path(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut rd = csv::Reader::from_path(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let headers = rd.headers().map_err(|e| format!("{}: {e}", path.display()))?.clone();
     let col = |name: &str| {
         headers.iter().position(|h| h == name).ok_or_else(|| {
@@ -241,7 +241,7 @@ fn ours(f: &Figure, rs: &[Run]) -> String {
             (None, None) => format!("{}: no result", label(r.case, &f.label)),
         })
         .collect();
-    let mut text = format!("`{m}`: {}.", parts.drain(..).collect::<Vec<_>>().join("; "));
+    let mut text = format!("`{m}`: {}.", std::mem::take(&mut parts).join("; "));
     if f.converges {
         let key = f.label.last().expect("validated");
         let mut pts: Vec<(f64, Option<f64>)> =

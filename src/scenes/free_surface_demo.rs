@@ -33,6 +33,10 @@ pub const ENTRY: SceneEntry = SceneEntry {
     metrics: &["surface_particles", "interior_surface_particles", "outer_layer_missed"],
 };
 
+/// Whether a particle belongs to the shape's outer layer (the particles a surface detection
+/// must flag).
+type OuterLayer = Box<dyn Fn(&Vector<2>) -> bool>;
+
 fn params() -> Vec<Spec> {
     let mut v = vec![
         Spec::choice("shape", &["ring", "patch", "column"], "ring", "what to detect the surface of"),
@@ -54,28 +58,27 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     if dx > 0.1 {
         return Err(format!("scene `free_surface_demo`: `dx` = {dx} leaves too few particles (at most 0.1)"));
     }
-    let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, Box<dyn Fn(&Vector<2>) -> bool>) =
-        match p.str("shape") {
-            "ring" => (
-                lattice(-1.0, 1.0, -1.0, 1.0, dx)
-                    .into_iter()
-                    .filter(|x| (0.5..1.0).contains(&x.norm()))
-                    .collect(),
-                Vec::new(),
-                Box::new(move |x: &Vector<2>| x.norm() > 1.0 - dx || x.norm() < 0.5 + dx),
-            ),
-            "patch" => (
-                lattice(0.0, 1.0, 0.0, 0.3, dx),
-                box_walls(1.0, 0.3, dx, 3, false).into_iter().filter(|(x, _)| x[1] < 0.0).collect(),
-                Box::new(move |x: &Vector<2>| x[1] > 0.3 - dx || x[0] < dx || x[0] > 1.0 - dx),
-            ),
-            _ => (
-                lattice(0.0, 1.0, 0.0, 2.0, dx),
-                box_walls(4.0, 3.0, dx, 3, false),
-                Box::new(move |x: &Vector<2>| x[1] > 2.0 - dx || x[0] > 1.0 - dx),
-            ),
-        };
-    let outer: Vec<bool> = x.iter().map(|x| outer(x)).collect();
+    let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, OuterLayer) = match p.str("shape") {
+        "ring" => (
+            lattice(-1.0, 1.0, -1.0, 1.0, dx)
+                .into_iter()
+                .filter(|x| (0.5..1.0).contains(&x.norm()))
+                .collect(),
+            Vec::new(),
+            Box::new(move |x: &Vector<2>| x.norm() > 1.0 - dx || x.norm() < 0.5 + dx),
+        ),
+        "patch" => (
+            lattice(0.0, 1.0, 0.0, 0.3, dx),
+            box_walls(1.0, 0.3, dx, 3, false).into_iter().filter(|(x, _)| x[1] < 0.0).collect(),
+            Box::new(move |x: &Vector<2>| x[1] > 0.3 - dx || x[0] < dx || x[0] > 1.0 - dx),
+        ),
+        _ => (
+            lattice(0.0, 1.0, 0.0, 2.0, dx),
+            box_walls(4.0, 3.0, dx, 3, false),
+            Box::new(move |x: &Vector<2>| x[1] > 2.0 - dx || x[0] > 1.0 - dx),
+        ),
+    };
+    let outer: Vec<bool> = x.iter().map(outer).collect();
     let constants = FluidConstants {
         rho0: RHO0,
         c0: 10.0,

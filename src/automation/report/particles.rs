@@ -354,6 +354,6 @@ mod tests {
         assert_eq!(typical_spacing(&[], &[]), 1.0);
         assert_eq!(typical_spacing(&[1.0, 1.0], &[2.0, 2.0]), 1.0);
         let x: Vec<f64> = (0..10).map(|i| i as f64 * 0.1).collect();
-        assert!((typical_spacing(&x, &vec![0.0; 10]) - 0.1).abs() < 1e-12); // a line
+        assert!((typical_spacing(&x, &[0.0; 10]) - 0.1).abs() < 1e-12); // a line
     }
 }

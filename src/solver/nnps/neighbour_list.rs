@@ -183,9 +183,9 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
             chunk.clear();
-            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
+            for q in &queries[c * CHUNK..((c + 1) * CHUNK).min(n)] {
                 chunk.start.push(chunk.entries.len() as u32);
-                cells.visit(sources, &queries[i], |j, _, r2, wraps| {
+                cells.visit(sources, q, |j, _, r2, wraps| {
                     let mut code = 0u32;
                     for k in (0..D).rev() {
                         code = code * 3 + (wraps[k].clamp(-1, 1) + 1) as u32;

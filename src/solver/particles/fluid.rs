@@ -94,9 +94,12 @@ impl<const D: usize> Fluid<D> {
                 return Err(format!("fluid `{name}`: {field} has {len} entries for {n} particles"));
             }
         }
+        // `!(v > 0.0)` also rejects NaN.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if let Some(i) = init.m.iter().position(|&m| !(m > 0.0)) {
             return Err(format!("fluid `{name}`: particle {i} has non-positive mass {}", init.m[i]));
         }
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
             return Err(format!("fluid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
         }
