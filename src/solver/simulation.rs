@@ -409,9 +409,17 @@ impl<const D: usize> Simulation<D> {
         let u_max = u2.sqrt();
         let bound = self.time_settings.blowup_factor * self.time_settings.c0;
         if u_max > bound {
+            // Which particle (found only now, on the way out), so that the report says where.
+            let fast = (0..f.len()).max_by(|&a, &b| f.u[a].norm_squared().total_cmp(&f.u[b].norm_squared()));
+            let fast = fast.expect("a body has particles");
             return Err(fail(format!(
-                "max |u| = {u_max:.4e} exceeds {} c0 = {bound:.4e}",
-                self.time_settings.blowup_factor
+                "max |u| = {u_max:.4e} exceeds {} c0 = {bound:.4e} (particle {} of body `{}`, at {:?}, p = {:.4e}, rho = {:.4e})",
+                self.time_settings.blowup_factor,
+                f.id[fast],
+                f.name,
+                f.x[fast].as_slice(),
+                f.p[fast],
+                f.rho[fast]
             )));
         }
         self.state.u_max = u_max;
