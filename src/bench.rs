@@ -7,6 +7,47 @@ use crate::scenes::taylor_green;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
+/// What a peer code (e.g. `../shared/peers/pysph-taylor-green.sh`) reported for one
+/// resolution and thread count, run in the same sitting.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct PeerResult {
+    /// The peer's name, as it reports it (e.g. `pysph-1.0b2`).
+    pub peer: String,
+    /// Particles per side.
+    pub nx: usize,
+    /// Threads it ran on.
+    pub threads: usize,
+    /// Its particle-steps per second.
+    pub particle_steps_per_second: f64,
+    /// The simulated time it ran to (shorter at large nx, so that it takes minutes).
+    pub tf: f64,
+}
+
+/// The simulated time a peer runs at resolution `nx`: t = 2 (the Taylor-Green run)
+/// while that is under about 70 million particle-steps (dt = 0.25 h / 11 with h = 1/nx),
+/// shorter beyond, so that each peer run takes a minute or two.
+pub fn peer_tf(nx: usize) -> f64 {
+    let steps_per_unit_time = 44.0 * nx as f64;
+    (7.0e7 / ((nx * nx) as f64 * steps_per_unit_time)).min(2.0)
+}
+
+/// Reads a peer's one-line JSON report (`particle_steps_per_second` and `peer`).
+pub fn parse_peer(stdout: &str, nx: usize, threads: usize, tf: f64) -> Result<PeerResult, String> {
+    let line = stdout.lines().rev().find(|l| l.trim_start().starts_with('{')).ok_or("no JSON line")?;
+    let v: serde_json::Value = serde_json::from_str(line).map_err(|e| format!("unreadable JSON: {e}"))?;
+    let speed = v["particle_steps_per_second"]
+        .as_f64()
+        .filter(|s| *s > 0.0)
+        .ok_or("no positive `particle_steps_per_second`")?;
+    Ok(PeerResult {
+        peer: v["peer"].as_str().unwrap_or("peer").to_string(),
+        nx,
+        threads,
+        particle_steps_per_second: speed,
+        tf,
+    })
+}
+
 /// One measured configuration.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BenchResult {
@@ -100,11 +141,20 @@ pub fn default_steps(n: usize) -> u64 {
 }
 
 /// The benchmark table as Markdown, with the throughput of each variant relative to
-/// `edac` on the same size and threads, and the two-thread speed-up.
-pub fn table(results: &[BenchResult]) -> String {
+/// `edac` on the same size and threads, and the two-thread speed-up; with peer results, the
+/// peer's throughput and our ratio to it on the same size and threads.
+pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
-        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
     );
+    if !peers.is_empty() {
+        s.push_str(" peer Mparticle-steps/s | ratio to peer |");
+    }
+    s.push_str("\n|---|---|---|---|---|---|---|---|---|---|---|---|");
+    if !peers.is_empty() {
+        s.push_str("---|---|");
+    }
+    s.push('\n');
     for r in results {
         let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
         let one = results.iter().find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
@@ -142,6 +192,46 @@ pub fn table(results: &[BenchResult]) -> String {
             r.ipst_iterations_mean,
             shares
         ));
+        if !peers.is_empty() {
+            match peers.iter().find(|p| p.nx == r.nx && p.threads == r.threads) {
+                Some(p) => s.insert_str(
+                    s.len() - 1,
+                    &format!(
+                        " {:.3} | {:.1}x |",
+                        p.particle_steps_per_second / 1e6,
+                        r.particle_steps_per_second / p.particle_steps_per_second
+                    ),
+                ),
+                None => s.insert_str(s.len() - 1, "  |  |"),
+            }
+        }
     }
     s
+}
+
+#[cfg(test)]
+mod peer_tests {
+    use super::*;
+
+    #[test]
+    fn peers_run_t_2_where_it_is_cheap_and_about_70_million_particle_steps_beyond() {
+        assert_eq!(peer_tf(50), 2.0);
+        for nx in [200, 400] {
+            let steps = peer_tf(nx) * 44.0 * nx as f64;
+            let particle_steps = steps * (nx * nx) as f64;
+            assert!((particle_steps - 7.0e7).abs() < 1.0, "nx = {nx}: {particle_steps}");
+        }
+    }
+
+    #[test]
+    fn a_peer_report_is_read_from_its_last_json_line() {
+        let out = "installing...\n{\"peer\": \"pysph-1.0b2\", \"particle_steps_per_second\": 3.3e5}\n";
+        let p = parse_peer(out, 50, 2, 2.0).unwrap();
+        assert_eq!(
+            (p.peer.as_str(), p.particle_steps_per_second, p.nx, p.threads),
+            ("pysph-1.0b2", 3.3e5, 50, 2)
+        );
+        assert!(parse_peer("no json", 50, 2, 2.0).is_err());
+        assert!(parse_peer("{\"particle_steps_per_second\": 0}", 50, 2, 2.0).is_err());
+    }
 }

@@ -163,6 +163,12 @@ enum Command {
         /// Where to write the results as JSON.
         #[arg(long, default_value = "output/bench.json")]
         json: PathBuf,
+        /// A peer code's runner to measure in the same sitting, e.g.
+        /// `../shared/peers/pysph-taylor-green.sh`: called with `--nx N --tf T --threads K`
+        /// for every resolution and thread count, it must print one JSON line with
+        /// `particle_steps_per_second`; the table then gives our ratio to it.
+        #[arg(long)]
+        peer: Option<PathBuf>,
     },
     /// One benchmark configuration in this process (used by `bench`).
     #[command(hide = true)]
@@ -295,8 +301,8 @@ fn run(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Bench { nx, bench_threads, variants, steps, json } => {
-            run_bench(nx, bench_threads, variants, steps, json)
+        Command::Bench { nx, bench_threads, variants, steps, json, peer } => {
+            run_bench(nx, bench_threads, variants, steps, json, peer)
         }
         Command::BenchCase { variant, nx, steps } => match bench::run_case(&variant, nx, steps, 5) {
             Ok(r) => {
@@ -317,6 +323,7 @@ fn run_bench(
     variants: Option<Vec<String>>,
     steps: Option<u64>,
     json: PathBuf,
+    peer: Option<PathBuf>,
 ) -> ExitCode {
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
@@ -365,14 +372,49 @@ fn run_bench(
             }
         }
     }
-    println!("{}", bench::table(&results));
+    let mut peers = Vec::new();
+    if let Some(script) = &peer {
+        for &n in &nx {
+            for &t in &threads {
+                let tf = bench::peer_tf(n);
+                eprint!("peer {} nx={n} threads={t} tf={tf:.4} ... ", script.display());
+                let out = std::process::Command::new(script)
+                    .args(["--nx", &n.to_string(), "--tf", &format!("{tf}"), "--threads", &t.to_string()])
+                    .stderr(std::process::Stdio::inherit())
+                    .output();
+                let parsed = match out {
+                    Ok(o) if o.status.success() => {
+                        bench::parse_peer(&String::from_utf8_lossy(&o.stdout), n, t, tf)
+                    }
+                    Ok(o) => Err(format!("exit status {}", o.status)),
+                    Err(e) => Err(e.to_string()),
+                };
+                match parsed {
+                    Ok(p) => {
+                        eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                        peers.push(p);
+                    }
+                    Err(e) => {
+                        eprintln!("error: peer {}: {e}", script.display());
+                        return ExitCode::from(1);
+                    }
+                }
+            }
+        }
+    }
+    println!("{}", bench::table(&results, &peers));
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!("error: {}: {e}", dir.display());
             return ExitCode::from(1);
         }
     }
-    let text = serde_json::to_string_pretty(&results).expect("serialises");
+    let text = if peers.is_empty() {
+        serde_json::to_string_pretty(&results)
+    } else {
+        serde_json::to_string_pretty(&serde_json::json!({ "results": results, "peers": peers }))
+    }
+    .expect("serialises");
     if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {
         eprintln!("error: {}: {e}", json.display());
         return ExitCode::from(1);

@@ -146,3 +146,47 @@ fn a_completed_run_writes_the_contracted_outputs() {
     assert_eq!(n, 11, "snapshots at 0, tf/10, ..., tf");
     assert!(dir.path().join("vtu/fluid_00010.vtu").exists());
 }
+
+/// `bench --peer` runs the peer in the same sitting for every size and thread count and
+/// gives our ratio to it; a failing peer fails the bench, naming the script.
+#[test]
+fn bench_measures_a_peer_in_the_same_sitting() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let script = |name: &str, body: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, format!("#!/bin/sh\n{body}\n")).unwrap();
+        std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
+        p
+    };
+    // A peer that reports 0.125 M particle-steps/s and echoes the time it was asked to run.
+    let good = script(
+        "peer.sh",
+        r#"echo "{\"peer\": \"fake\", \"particle_steps_per_second\": 125000.0, \"args\": \"$*\"}""#,
+    );
+    let json = dir.path().join("bench.json");
+    let bin = env!("CARGO_BIN_EXE_sphrepro");
+    let out = Command::new(bin)
+        .args(["bench", "--nx", "20", "--bench-threads", "1", "--variants", "edac", "--steps", "5"])
+        .args(["--json", json.to_str().unwrap(), "--peer", good.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(table.contains("ratio to peer"), "{table}");
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let (ours, peer) = (&v["results"][0], &v["peers"][0]);
+    assert_eq!(peer["nx"], 20);
+    assert_eq!(peer["tf"], 2.0, "small sizes run the issue's t = 2");
+    let ratio = ours["particle_steps_per_second"].as_f64().unwrap() / 125000.0;
+    assert!(table.contains(&format!("| 0.125 | {ratio:.1}x |")), "{table}");
+    // A peer that fails.
+    let bad = script("broken.sh", "echo 'no PySPH here' >&2; exit 3");
+    let out = Command::new(bin)
+        .args(["bench", "--nx", "20", "--bench-threads", "1", "--variants", "edac", "--steps", "5"])
+        .args(["--json", json.to_str().unwrap(), "--peer", bad.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("broken.sh"));
+}
