@@ -30,40 +30,35 @@ pub fn simd_available() -> bool {
     }
 }
 
-/// Writes the entries of the candidates within `sqrt(r2max)` of `xi` to the front of
-/// `out_entries`, their r2 to the front of `out_r2`, and returns how many. Both outputs must
-/// hold the number of candidates plus [`LANES`]. `simd` must come from [`simd_available`].
-pub fn within<const D: usize>(
-    simd: bool,
-    xi: &nalgebra::SVector<f64, D>,
-    c: &Candidates,
-    r2max: f64,
-    out_entries: &mut [u32],
-    out_r2: &mut [f64],
-) -> usize {
+/// Where the accepted candidates go, from the front: their entries and their r2. Both must
+/// hold the number of candidates plus [`LANES`].
+pub struct Accepted<'a> {
+    pub entries: &'a mut [u32],
+    pub r2: &'a mut [f64],
+}
+
+type Point<const D: usize> = nalgebra::SVector<f64, D>;
+
+/// Writes the candidates within `sqrt(r2max)` of `xi` to `out` and returns how many.
+/// `simd` must come from [`simd_available`].
+pub fn within<const D: usize>(simd: bool, xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
     let m = c.entries.len();
     assert!(c.x.len() == D * m && c.shift.len() == D * m, "one position and shift per candidate and axis");
-    assert!(out_entries.len() >= m + LANES && out_r2.len() >= m + LANES, "room past the last candidate");
+    assert!(out.entries.len() >= m + LANES && out.r2.len() >= m + LANES, "room past the last candidate");
     #[cfg(target_arch = "x86_64")]
     if simd {
         // SAFETY: the CPU has AVX-512F (checked by the caller through `simd_available`), and
         // the lengths were checked above: every load reads lanes below `m` (the others are
         // masked off), every store writes a full vector at an index at most `m`.
-        return unsafe { avx512::within(xi, c, r2max, out_entries, out_r2) };
+        return unsafe { avx512::within(xi, c, r2max, out) };
     }
     let _ = simd;
-    portable(xi, c, r2max, out_entries, out_r2)
+    portable(xi, c, r2max, out)
 }
 
 /// The portable path: appends every candidate and advances the length only for the
 /// accepted ones, so there is no branch on the distance test (which is unpredictable).
-fn portable<const D: usize>(
-    xi: &nalgebra::SVector<f64, D>,
-    c: &Candidates,
-    r2max: f64,
-    out_entries: &mut [u32],
-    out_r2: &mut [f64],
-) -> usize {
+fn portable<const D: usize>(xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
     let m = c.entries.len();
     let mut len = 0;
     for (k, &e) in c.entries.iter().enumerate() {
@@ -76,8 +71,8 @@ fn portable<const D: usize>(
         // see it, and a bounds check per store costs a third of this loop.
         // SAFETY: as just said.
         unsafe {
-            *out_entries.get_unchecked_mut(len) = e;
-            *out_r2.get_unchecked_mut(len) = r2;
+            *out.entries.get_unchecked_mut(len) = e;
+            *out.r2.get_unchecked_mut(len) = r2;
         }
         len += (r2 < r2max) as usize;
     }
@@ -86,20 +81,14 @@ fn portable<const D: usize>(
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::{Candidates, LANES};
+    use super::{Accepted, Candidates, Point, LANES};
     use std::arch::x86_64::*;
 
     /// Eight candidates at a time: r2 per lane, a compare into a mask, and the accepted
     /// lanes packed in a register (a compress to memory is slow on some CPUs) and stored
     /// whole at the current length.
     #[target_feature(enable = "avx512f")]
-    pub unsafe fn within<const D: usize>(
-        xi: &nalgebra::SVector<f64, D>,
-        c: &Candidates,
-        r2max: f64,
-        out_entries: &mut [u32],
-        out_r2: &mut [f64],
-    ) -> usize {
+    pub unsafe fn within<const D: usize>(xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
         let m = c.entries.len();
         let r2max = _mm512_set1_pd(r2max);
         let mut len = 0;
@@ -115,10 +104,10 @@ mod avx512 {
                 r2 = _mm512_add_pd(r2, _mm512_mul_pd(t, t));
             }
             let keep = _mm512_mask_cmp_pd_mask::<_CMP_LT_OQ>(live, r2, r2max);
-            _mm512_storeu_pd(out_r2.as_mut_ptr().add(len), _mm512_maskz_compress_pd(keep, r2));
+            _mm512_storeu_pd(out.r2.as_mut_ptr().add(len), _mm512_maskz_compress_pd(keep, r2));
             let e = _mm512_maskz_loadu_epi32(live as __mmask16, c.entries.as_ptr().add(k) as *const i32);
             let e = _mm512_maskz_compress_epi32(keep as __mmask16, e);
-            _mm256_storeu_si256(out_entries.as_mut_ptr().add(len) as *mut __m256i, _mm512_castsi512_si256(e));
+            _mm256_storeu_si256(out.entries.as_mut_ptr().add(len) as *mut __m256i, _mm512_castsi512_si256(e));
             len += keep.count_ones() as usize;
             k += LANES;
         }
@@ -142,7 +131,7 @@ mod tests {
             let xi = nalgebra::SVector::<f64, 2>::new(0.5, 0.25);
             let run = |simd| {
                 let (mut e, mut r2) = (vec![0u32; m + LANES], vec![0.0; m + LANES]);
-                let n = within(simd, &xi, &c, 0.09, &mut e, &mut r2);
+                let n = within(simd, &xi, &c, 0.09, Accepted { entries: &mut e, r2: &mut r2 });
                 e.truncate(n);
                 r2.truncate(n);
                 (e, r2)

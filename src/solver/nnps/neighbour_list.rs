@@ -149,8 +149,13 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                     x: &chunk.candidate_x,
                     shift: &chunk.candidate_shift,
                 };
-                let accepted =
-                    filter::within(simd, &points[i], &c, r2max, &mut chunk.entries[first..], &mut chunk.r2);
+                let accepted = filter::within(
+                    simd,
+                    &points[i],
+                    &c,
+                    r2max,
+                    filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
+                );
                 let len = first + accepted;
                 chunk.entries.truncate(len);
                 // The payload over whole vectors: the pairs padded with copies of the search
