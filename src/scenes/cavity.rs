@@ -20,7 +20,6 @@ use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -84,18 +83,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
-    let constants = FluidConstants {
-        rho0: RHO0,
-        c0: C0,
-        u_ref: U,
-        dx,
-        nu: Some(U * L / re),
-        alpha: None,
-        density: DensityModel::Summation,
-        gravity: [0.0; 3],
-        internal_flow: true,
-        free_surface: false,
-    };
+    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;

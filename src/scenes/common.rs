@@ -81,6 +81,55 @@ pub struct FluidConstants {
     pub free_surface: bool,
 }
 
+impl FluidConstants {
+    /// An internal flow at Reynolds number `re` on velocity `u` and length `l`: viscosity
+    /// `u l / re`, summation density, no gravity, no artificial viscosity, and an arbitrary
+    /// pressure level (the BQL reference of internal flows).
+    pub fn internal_flow(rho0: f64, c0: f64, u: f64, l: f64, re: f64, dx: f64) -> Self {
+        Self {
+            rho0,
+            c0,
+            u_ref: u,
+            dx,
+            nu: Some(u * l / re),
+            alpha: None,
+            density: DensityModel::Summation,
+            gravity: [0.0; 3],
+            internal_flow: true,
+            free_surface: false,
+        }
+    }
+
+    /// Water of depth `height` under gravity `g` with a free surface: reference velocity
+    /// `sqrt(2 g H)`, speed of sound ten times it, the continuity equation (25) for the
+    /// density, artificial viscosity `alpha` (eq. 28) and no physical viscosity.
+    pub fn under_gravity(rho0: f64, g: f64, height: f64, dx: f64, alpha: f64) -> Self {
+        Self {
+            rho0,
+            c0: 10.0 * (2.0 * g * height).sqrt(),
+            u_ref: (2.0 * g * height).sqrt(),
+            dx,
+            nu: None,
+            alpha: Some(alpha),
+            density: DensityModel::Continuity,
+            gravity: [0.0, -g, 0.0],
+            internal_flow: false,
+            free_surface: true,
+        }
+    }
+}
+
+/// Refuses the internal-flow schemes for a scene with a free surface.
+pub fn require_free_surface_scheme(scene: &str, p: &Params) -> Result<(), String> {
+    if p.str("scheme") == "ctvf" {
+        return Ok(());
+    }
+    Err(format!(
+        "scene `{scene}`: `scheme` = {}: a free-surface flow needs ctvf (edac and tvf are internal-flow schemes)",
+        p.str("scheme")
+    ))
+}
+
 /// The kernel, smoothing length and scheme the parameters ask for.
 pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme) {
     let h = p.float("hdx") * c.dx;

@@ -12,8 +12,8 @@
 //! largest x of the fluid, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
-    snapshot_bodies, wall_from, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, require_free_surface_scheme,
+    restore_sim, scheme_params, snapshot_bodies, wall_from, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
@@ -21,7 +21,6 @@ use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -100,26 +99,9 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     if l < 4.0 * dx || hc < 4.0 * dx {
         return bad("dx", "the column must be at least 4 particles wide and high".into());
     }
-    if p.str("scheme") != "ctvf" {
-        return Err(format!(
-            "scene `dam_break`: `scheme` = {}: a free-surface flow needs ctvf (edac and tvf are internal-flow schemes)",
-            p.str("scheme")
-        ));
-    }
-    let c0 = 10.0 * (2.0 * G * hc).sqrt();
-    let u_ref = (2.0 * G * hc).sqrt();
-    let constants = FluidConstants {
-        rho0: RHO0,
-        c0,
-        u_ref,
-        dx,
-        nu: None,
-        alpha: Some(p.float("alpha")),
-        density: DensityModel::Continuity,
-        gravity: [0.0, -G, 0.0],
-        internal_flow: false,
-        free_surface: true,
-    };
+    require_free_surface_scheme("dam_break", p)?;
+    let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
+    let (c0, u_ref) = (constants.c0, constants.u_ref);
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);

@@ -10,15 +10,14 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
-    snapshot_bodies, wall_from, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, require_free_surface_scheme,
+    restore_sim, scheme_params, snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -64,25 +63,9 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
             ));
         }
     }
-    if p.str("scheme") != "ctvf" {
-        return Err(format!(
-            "scene `hydrostatic_tank`: `scheme` = {}: a free-surface flow needs ctvf (edac and tvf are internal-flow schemes)",
-            p.str("scheme")
-        ));
-    }
-    let c0 = 10.0 * (2.0 * G * height).sqrt();
-    let constants = FluidConstants {
-        rho0: RHO0,
-        c0,
-        u_ref: (2.0 * G * height).sqrt(),
-        dx,
-        nu: None,
-        alpha: Some(p.float("alpha")),
-        density: DensityModel::Continuity,
-        gravity: [0.0, -G, 0.0],
-        internal_flow: false,
-        free_surface: true,
-    };
+    require_free_surface_scheme("hydrostatic_tank", p)?;
+    let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
+    let c0 = constants.c0;
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     check_wall_layers("hydrostatic_tank", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);

@@ -22,7 +22,6 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
-use crate::solver::scheme::DensityModel;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
@@ -89,18 +88,7 @@ pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
-    let constants = FluidConstants {
-        rho0: RHO0,
-        c0: C0,
-        u_ref: U,
-        dx,
-        nu: Some(U * L / re),
-        alpha: None,
-        density: DensityModel::Summation,
-        gravity: [0.0; 3],
-        internal_flow: true,
-        free_surface: false,
-    };
+    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
 
     // Lattice at cell centres, optionally perturbed (seeded), initialised from the exact
