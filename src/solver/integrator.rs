@@ -17,9 +17,7 @@ pub fn time_step(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) 
     cfl * dt
 }
 
-/// Particles per rayon task: a few flops per particle, so tasks must be long for the
-/// scheduling not to dominate at small sizes.
-const MIN_LEN: usize = 2048;
+use crate::solver::LIGHT_LOOP_LEN;
 
 /// Half kick, eq. (54) and (60): `u += dt/2 du/dt`.
 #[inline(always)]
@@ -43,7 +41,7 @@ pub fn kick_drift<const D: usize>(
     match u_hat {
         Some(u_hat) => {
             assert!(u_hat.len() == x.len() && a_c.len() == x.len(), "u~ and (du/dt)_c per particle");
-            x.par_iter_mut().zip(u).zip(u_hat).zip(du).zip(a_c).with_min_len(MIN_LEN).for_each(
+            x.par_iter_mut().zip(u).zip(u_hat).zip(du).zip(a_c).with_min_len(LIGHT_LOOP_LEN).for_each(
                 |((((x, u), uh), du), ac)| {
                     half_kick(u, du, dt);
                     *uh = *u + ac * (0.5 * dt);
@@ -51,7 +49,7 @@ pub fn kick_drift<const D: usize>(
                 },
             )
         }
-        None => x.par_iter_mut().zip(u).zip(du).with_min_len(MIN_LEN).for_each(|((x, u), du)| {
+        None => x.par_iter_mut().zip(u).zip(du).with_min_len(LIGHT_LOOP_LEN).for_each(|((x, u), du)| {
             half_kick(u, du, dt);
             *x += *u * dt;
         }),
@@ -60,7 +58,7 @@ pub fn kick_drift<const D: usize>(
 
 /// The closing half kick of a step, eq. (60).
 pub fn kick<const D: usize>(u: &mut [Vector<D>], du: &[Vector<D>], dt: f64) {
-    u.par_iter_mut().zip(du).with_min_len(MIN_LEN).for_each(|(u, a)| half_kick(u, a, dt));
+    u.par_iter_mut().zip(du).with_min_len(LIGHT_LOOP_LEN).for_each(|(u, a)| half_kick(u, a, dt));
 }
 
 #[cfg(test)]

@@ -15,3 +15,8 @@ pub mod output;
 pub mod particles;
 pub mod scheme;
 pub mod simulation;
+
+/// Particles per rayon task in the loops that do a few flops per particle (kicks, drift,
+/// wrapping, checks, explicit updates): tasks must be long for the scheduling not to
+/// dominate at small sizes.
+pub(crate) const LIGHT_LOOP_LEN: usize = 2048;

@@ -9,6 +9,7 @@ use crate::solver::scheme::{
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
     Shifting, SurfaceFields, WallSet,
 };
+use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -221,7 +222,7 @@ impl<const D: usize> Simulation<D> {
     /// then the wall pressure and velocities from the fluid.
     fn rebuild(&mut self) {
         let (domain, fluid) = (&self.domain, &mut self.state.fluid);
-        fluid.x.par_iter_mut().with_min_len(2048).for_each(|x| domain.wrap(x));
+        fluid.x.par_iter_mut().with_min_len(LIGHT_LOOP_LEN).for_each(|x| domain.wrap(x));
         self.cells.update(&fluid.x);
         fluid.reorder(self.cells.order());
         self.cells.mark_reordered();
@@ -361,7 +362,7 @@ impl<const D: usize> Simulation<D> {
             .fluid
             .u
             .par_iter()
-            .with_min_len(2048)
+            .with_min_len(LIGHT_LOOP_LEN)
             .map(|u| u.norm_squared())
             .reduce(|| 0.0, f64::max)
             .sqrt()
@@ -376,7 +377,7 @@ impl<const D: usize> Simulation<D> {
         // and order-independent, so the outcome does not depend on the thread count.
         let (u2, bad) = (0..f.len())
             .into_par_iter()
-            .with_min_len(2048)
+            .with_min_len(LIGHT_LOOP_LEN)
             .map(|i| {
                 let ok = f.x[i].iter().all(|v| v.is_finite())
                     && f.u[i].iter().all(|v| v.is_finite())

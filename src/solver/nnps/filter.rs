@@ -6,6 +6,8 @@
 //! the same order, so they accept the same candidates and return the same r2, bit for bit
 //! (tested), and the r2 equals the one `NeighbourList::for_each` recomputes.
 
+use crate::solver::math::Vector;
+
 /// Candidates per vector: callers leave this much room past the last candidate in the
 /// output slices, which the vector path may write (and the caller then truncates).
 pub const LANES: usize = 8;
@@ -37,11 +39,15 @@ pub struct Accepted<'a> {
     pub r2: &'a mut [f64],
 }
 
-type Point<const D: usize> = nalgebra::SVector<f64, D>;
-
 /// Writes the candidates within `sqrt(r2max)` of `xi` to `out` and returns how many.
 /// `simd` must come from [`simd_available`].
-pub fn within<const D: usize>(simd: bool, xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
+pub fn within<const D: usize>(
+    simd: bool,
+    xi: &Vector<D>,
+    c: &Candidates,
+    r2max: f64,
+    out: Accepted,
+) -> usize {
     let m = c.entries.len();
     assert!(c.x.len() == D * m && c.shift.len() == D * m, "one position and shift per candidate and axis");
     assert!(out.entries.len() >= m + LANES && out.r2.len() >= m + LANES, "room past the last candidate");
@@ -58,7 +64,7 @@ pub fn within<const D: usize>(simd: bool, xi: &Point<D>, c: &Candidates, r2max: 
 
 /// The portable path: appends every candidate and advances the length only for the
 /// accepted ones, so there is no branch on the distance test (which is unpredictable).
-fn portable<const D: usize>(xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
+fn portable<const D: usize>(xi: &Vector<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
     let m = c.entries.len();
     let mut len = 0;
     for (k, &e) in c.entries.iter().enumerate() {
@@ -81,14 +87,14 @@ fn portable<const D: usize>(xi: &Point<D>, c: &Candidates, r2max: f64, out: Acce
 
 #[cfg(target_arch = "x86_64")]
 mod avx512 {
-    use super::{Accepted, Candidates, Point, LANES};
+    use super::{Accepted, Candidates, Vector, LANES};
     use std::arch::x86_64::*;
 
     /// Eight candidates at a time: r2 per lane, a compare into a mask, and the accepted
     /// lanes packed in a register (a compress to memory is slow on some CPUs) and stored
     /// whole at the current length.
     #[target_feature(enable = "avx512f")]
-    pub unsafe fn within<const D: usize>(xi: &Point<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
+    pub unsafe fn within<const D: usize>(xi: &Vector<D>, c: &Candidates, r2max: f64, out: Accepted) -> usize {
         let m = c.entries.len();
         let r2max = _mm512_set1_pd(r2max);
         let mut len = 0;

@@ -11,6 +11,7 @@ use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, NeighbourList};
 use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 
 /// Particles per rayon task: large enough that scheduling is noise.
@@ -230,7 +231,7 @@ impl<const D: usize> FluidPasses<D> {
                     .p
                     .par_iter_mut()
                     .zip(&fluid.rho)
-                    .with_min_len(2048)
+                    .with_min_len(LIGHT_LOOP_LEN)
                     .for_each(|(p, &rho)| *p = c2 * (rho - rho0));
             }
         }
@@ -583,5 +584,5 @@ impl AccelTerms {
 }
 
 fn apply(v: &mut [f64], rate: &[f64], dt: f64) {
-    v.par_iter_mut().zip(rate).with_min_len(2048).for_each(|(v, r)| *v += dt * r);
+    v.par_iter_mut().zip(rate).with_min_len(LIGHT_LOOP_LEN).for_each(|(v, r)| *v += dt * r);
 }
