@@ -244,6 +244,16 @@ impl ScaledKernel {
             }
         })
     }
+
+    /// [`w`](Self::w) at the distances `r[k]` into `out[k]` (for callers that need `r`
+    /// themselves and take the square root once).
+    pub fn w_batch_at_distances(&self, r: &[f64], out: &mut [f64]) {
+        with_shape!(self.kernel.kind, shape => {
+            for (o, &r) in out.iter_mut().zip(r) {
+                *o = self.fac * shape(r * self.inv_h).0;
+            }
+        })
+    }
 }
 
 #[cfg(test)]
@@ -354,11 +364,15 @@ mod tests {
             let r2: Vec<f64> = (0..1000).map(|i| (i as f64 * 1.1e-4).powi(2)).collect();
             let mut both = vec![(0.0, 0.0); r2.len()];
             let mut w = vec![0.0; r2.len()];
+            let mut w_at_r = vec![0.0; r2.len()];
             k.w_and_grad_factor_batch(&r2, &mut both);
             k.w_batch(&r2, &mut w);
+            let r: Vec<f64> = r2.iter().map(|r2| r2.sqrt()).collect();
+            k.w_batch_at_distances(&r, &mut w_at_r);
             for (i, &r2) in r2.iter().enumerate() {
                 assert_eq!(both[i], k.w_and_grad_factor(r2.sqrt()), "{kind:?} at r2 = {r2}");
                 assert_eq!(w[i], k.w(r2.sqrt()));
+                assert_eq!(w_at_r[i], w[i]);
             }
         }
     }

@@ -36,16 +36,16 @@ fn powi_small(x: f64, n: i32) -> f64 {
 /// [`ipst_weight`].
 #[inline(always)]
 pub fn ipst_displacement<const D: usize>(v_b: f64, ab: &Pair<D>) -> Vector<D> {
-    ab.xij * ipst_weight(v_b, ab.wij, ab.r2)
+    ab.xij * ipst_weight(v_b, ab.wij, ab.r2.sqrt())
 }
 
 /// `V_b W_ab / r_ab` (0 at r = 0), the factor of `x_ab` in eq. (37); on scalars alone so
 /// that a block of pairs evaluates it in one vectorised loop. Takes the neighbour's volume
 /// `v_b`: the iterations move copies of the positions and read nothing else of it.
 #[inline(always)]
-pub fn ipst_weight(v_b: f64, w: f64, r2: f64) -> f64 {
-    let f = v_b * w / r2.sqrt();
-    if r2 > 0.0 {
+pub fn ipst_weight(v_b: f64, w: f64, r: f64) -> f64 {
+    let f = v_b * w / r;
+    if r > 0.0 {
         f
     } else {
         0.0

@@ -244,30 +244,34 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
-    /// Appends the neighbours of query point `i` at `xi` to `j`, their differences `x_ij`
-    /// to `xij` and `|x_ij|^2` to `r2`, as [`for_each_from`](Self::for_each_from) visits
-    /// them: the pairs as arrays, for passes that evaluate them in vectorised loops.
-    pub fn append_pairs(
+    /// Number of neighbours of query point `i`.
+    #[inline(always)]
+    pub fn count(&self, i: usize) -> usize {
+        let chunk = &self.chunks[i / CHUNK];
+        let l = i % CHUNK;
+        (chunk.start[l + 1] - chunk.start[l]) as usize
+    }
+
+    /// Writes the neighbours of query point `i` at `xi` into the first
+    /// [`count(i)`](Self::count) elements of `j`, their differences `x_ij` into `xij` and
+    /// `|x_ij|^2` into `r2`, as [`for_each_from`](Self::for_each_from) visits them: the pairs
+    /// as arrays, for passes that evaluate them in vectorised loops. Panics if a slice is
+    /// shorter than the count.
+    #[inline(always)]
+    pub fn write_pairs(
         &self,
         i: usize,
         xi: Vector<D>,
         points: &[Vector<D>],
-        j: &mut Vec<u32>,
-        xij: &mut Vec<Vector<D>>,
-        r2: &mut Vec<f64>,
+        j: &mut [u32],
+        xij: &mut [Vector<D>],
+        r2: &mut [f64],
     ) {
         let chunk = &self.chunks[i / CHUNK];
         let l = i % CHUNK;
         let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
-        // Sized first and written in place: pushes would check the capacity per pair.
-        let from = j.len();
-        let to = from + entries.len();
-        j.resize(to, 0);
-        xij.resize(to, Vector::zeros());
-        r2.resize(to, 0.0);
-        for (((&e, j), xij), r2) in
-            entries.iter().zip(&mut j[from..]).zip(&mut xij[from..]).zip(&mut r2[from..])
-        {
+        let n = entries.len();
+        for (((&e, j), xij), r2) in entries.iter().zip(&mut j[..n]).zip(&mut xij[..n]).zip(&mut r2[..n]) {
             *j = e & J_MASK;
             *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[*j as usize];
             *r2 = xij.norm_squared();

@@ -121,6 +121,8 @@ pub struct FluidPasses<const D: usize> {
     x_next: Vec<Vector<D>>,
     ipst_pairs: Vec<IpstPairs<D>>,
     chi: Vec<f64>,
+    vol: Vec<f64>,
+    wall_vol: Vec<f64>,
     points: Vec<Point<D>>,
     wall_div: Vec<Point<D>>,
     wall_visc: Vec<Point<D>>,
@@ -340,8 +342,14 @@ impl<const D: usize> FluidPasses<D> {
         self.x_shift.extend_from_slice(&fluid.x);
         self.x_next.resize(n, Vector::zeros());
         self.chi.resize(n, 0.0);
-        // The volumes gathered by `accelerations` at these positions.
-        let (pts, wall_pts) = (&self.points, &self.wall_div);
+        // The volumes gathered by `accelerations` at these positions, as compact arrays
+        // (the sweeps read nothing else of the neighbours).
+        self.vol.resize(n, 0.0);
+        let pts = &self.points;
+        self.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = pts[i].v());
+        self.wall_vol.clear();
+        self.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
+        let (vol, wall_vol) = (&self.vol, &self.wall_vol);
         let mut iterations = 0;
         while iterations < max_iter {
             // One sweep: chi at the current positions (eq. 40) and the moved positions
@@ -358,7 +366,7 @@ impl<const D: usize> FluidPasses<D> {
                 .for_each(|(c, ((next, chi), pairs))| {
                     for (l, (next, chi)) in next.iter_mut().zip(chi.iter_mut()).enumerate() {
                         let i = c * MIN_LEN + l;
-                        let (d, x) = pairs.sums(i, xs, nl, pts, walls.map(|ws| (ws, &wall_pts[..])), &k);
+                        let (d, x) = pairs.sums(i, xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
                         let mut dr = d * (u_max * dt);
                         if let Some(fs) = surface {
                             // eq. (45)
@@ -392,7 +400,8 @@ impl<const D: usize> FluidPasses<D> {
 struct IpstPairs<const D: usize> {
     j: Vec<u32>,
     xij: Vec<Vector<D>>,
-    r2: Vec<f64>,
+    /// |x_ij|^2, then |x_ij|.
+    r: Vec<f64>,
     vol: Vec<f64>,
     w: Vec<f64>,
     weight: Vec<f64>,
@@ -400,39 +409,47 @@ struct IpstPairs<const D: usize> {
 
 impl<const D: usize> IpstPairs<D> {
     /// `(sum V_b n_ab W_ab, sum h^2 W_ab)` of particle `i` at positions `xs`, over the
-    /// fluid (volumes `pts`) and the walls (with theirs).
+    /// fluid (volumes `vol`) and the walls (with theirs).
     fn sums(
         &mut self,
         i: usize,
         xs: &[Vector<D>],
         nl: &KernelList<D>,
-        pts: &[Point<D>],
-        walls: Option<(&WallSet<D>, &[Point<D>])>,
+        vol: &[f64],
+        walls: Option<(&WallSet<D>, &[f64])>,
         k: &ScaledKernel,
     ) -> (Vector<D>, f64) {
-        self.j.clear();
-        self.xij.clear();
-        self.r2.clear();
-        self.vol.clear();
-        nl.append_pairs(i, xs[i], xs, &mut self.j, &mut self.xij, &mut self.r2);
-        self.vol.extend(self.j.iter().map(|&j| pts[j as usize].v()));
-        if let Some((ws, wall_pts)) = walls {
-            let from = self.j.len();
-            ws.fluid_to_wall.append_pairs(i, xs[i], &ws.wall.x, &mut self.j, &mut self.xij, &mut self.r2);
-            self.vol.extend(self.j[from..].iter().map(|&j| wall_pts[j as usize].v()));
-        }
-        // Whole vectors for the batch loops (no scalar tail): pad, then ignore the padding.
-        let n = self.r2.len();
+        let n_fluid = nl.count(i);
+        let n = n_fluid + walls.map_or(0, |(ws, _)| ws.fluid_to_wall.count(i));
+        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so a
+        // particle's padding holds an earlier particle's (finite) values, ignored below.
         let padded = n.next_multiple_of(8);
-        self.r2.resize(padded, 0.0);
-        self.vol.resize(padded, 0.0);
-        self.w.resize(padded, 0.0);
-        self.weight.resize(padded, 0.0);
-        k.w_batch(&self.r2, &mut self.w);
+        if self.r.len() < padded {
+            self.j.resize(padded, 0);
+            self.xij.resize(padded, Vector::zeros());
+            for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.weight] {
+                a.resize(padded, 0.0);
+            }
+        }
+        nl.write_pairs(i, xs[i], xs, &mut self.j, &mut self.xij, &mut self.r);
+        for (v, &j) in self.vol[..n_fluid].iter_mut().zip(&self.j) {
+            *v = vol[j as usize];
+        }
+        if let Some((ws, wall_vol)) = walls {
+            let (j, xij, r) = (&mut self.j[n_fluid..], &mut self.xij[n_fluid..], &mut self.r[n_fluid..]);
+            ws.fluid_to_wall.write_pairs(i, xs[i], &ws.wall.x, j, xij, r);
+            for (v, &j) in self.vol[n_fluid..n].iter_mut().zip(&self.j[n_fluid..]) {
+                *v = wall_vol[j as usize];
+            }
+        }
+        let r = &mut self.r[..padded];
+        for r in r.iter_mut() {
+            *r = r.sqrt();
+        }
+        k.w_batch_at_distances(r, &mut self.w[..padded]);
         // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
-        for (((f, &v), w), &r2) in self.weight.iter_mut().zip(&self.vol).zip(self.w.iter_mut()).zip(&self.r2)
-        {
-            *f = shifting::ipst_weight(v, *w, r2);
+        for (((f, &v), w), &r) in self.weight[..padded].iter_mut().zip(&self.vol).zip(&mut self.w).zip(&*r) {
+            *f = shifting::ipst_weight(v, *w, r);
             *w = shifting::ipst_chi(k.h, *w);
         }
         let (mut d, mut chi) = (Vector::<D>::zeros(), 0.0);
