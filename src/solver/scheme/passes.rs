@@ -120,7 +120,6 @@ pub struct FluidPasses<const D: usize> {
     x_shift: Vec<Vector<D>>,
     x_next: Vec<Vector<D>>,
     ipst_pairs: Vec<IpstPairs<D>>,
-    chi: Vec<f64>,
     vol: Vec<f64>,
     wall_vol: Vec<f64>,
     points: Vec<Point<D>>,
@@ -341,7 +340,6 @@ impl<const D: usize> FluidPasses<D> {
         self.x_shift.clear();
         self.x_shift.extend_from_slice(&fluid.x);
         self.x_next.resize(n, Vector::zeros());
-        self.chi.resize(n, 0.0);
         // The volumes gathered by `accelerations` at these positions, as compact arrays
         // (the sweeps read nothing else of the neighbours).
         self.vol.resize(n, 0.0);
@@ -358,26 +356,29 @@ impl<const D: usize> FluidPasses<D> {
             // In fixed blocks of particles, each with its own pair arrays kept from step to
             // step (so that the sweeps allocate nothing once they have grown).
             self.ipst_pairs.resize_with(n.div_ceil(MIN_LEN), IpstPairs::default);
-            self.x_next
+            // Each block returns its largest chi (max is exact: any grouping gives the same).
+            let chi_max = self
+                .x_next
                 .par_chunks_mut(MIN_LEN)
-                .zip(self.chi.par_chunks_mut(MIN_LEN))
                 .zip(self.ipst_pairs.par_iter_mut())
                 .enumerate()
-                .for_each(|(c, ((next, chi), pairs))| {
-                    for (l, (next, chi)) in next.iter_mut().zip(chi.iter_mut()).enumerate() {
+                .map(|(c, (next, pairs))| {
+                    let mut chi_max = f64::MIN;
+                    for (l, next) in next.iter_mut().enumerate() {
                         let i = c * MIN_LEN + l;
-                        let (d, x) = pairs.sums(i, xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
+                        let (d, chi) = pairs.sums(i, xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
                         let mut dr = d * (u_max * dt);
                         if let Some(fs) = surface {
                             // eq. (45)
                             dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
                         }
-                        *chi = x;
+                        chi_max = chi_max.max(chi);
                         // Not wrapped: the list's image shifts refer to the unwrapped positions.
                         *next = xs[i] + dr;
                     }
-                });
-            let chi_max = self.chi.iter().fold(f64::MIN, |m, &v| m.max(v));
+                    chi_max
+                })
+                .reduce(|| f64::MIN, f64::max);
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
                 break;
             }
