@@ -364,17 +364,21 @@ impl<const D: usize> FluidPasses<D> {
                 .enumerate()
                 .map(|(c, (next, pairs))| {
                     let mut chi_max = f64::MIN;
-                    for (l, next) in next.iter_mut().enumerate() {
-                        let i = c * MIN_LEN + l;
-                        let (d, chi) = pairs.sums(i, xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
-                        let mut dr = d * (u_max * dt);
-                        if let Some(fs) = surface {
-                            // eq. (45)
-                            dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                    for (g, next) in next.chunks_mut(IPST_GROUP).enumerate() {
+                        let first = c * MIN_LEN + g * IPST_GROUP;
+                        pairs.evaluate(first..first + next.len(), xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
+                        for (l, next) in next.iter_mut().enumerate() {
+                            let i = first + l;
+                            let (d, chi) = pairs.sums(l);
+                            let mut dr = d * (u_max * dt);
+                            if let Some(fs) = surface {
+                                // eq. (45)
+                                dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                            }
+                            chi_max = chi_max.max(chi);
+                            // Not wrapped: the list's image shifts refer to the unwrapped positions.
+                            *next = xs[i] + dr;
                         }
-                        chi_max = chi_max.max(chi);
-                        // Not wrapped: the list's image shifts refer to the unwrapped positions.
-                        *next = xs[i] + dr;
                     }
                     chi_max
                 })
@@ -394,11 +398,20 @@ impl<const D: usize> FluidPasses<D> {
     }
 }
 
-/// One particle's pairs at moved positions, as arrays (reused from particle to particle),
-/// for the IPST sums of eqs. (37) and (40): the kernel and the weights are evaluated for
-/// all the pairs at once in vectorised loops, then summed in the neighbour order.
+/// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
+/// cache level, and the vectorised loops run over the group's pairs, padded once.
+const IPST_GROUP: usize = 8;
+/// Vector lanes the pair arrays are padded to.
+const LANES: usize = 8;
+
+/// The pairs of a group of particles at moved positions, as arrays (reused from group to
+/// group), for the IPST sums of eqs. (37) and (40): the kernel and the weights are
+/// evaluated for all the pairs at once in vectorised loops, then each particle sums its
+/// own in the neighbour order.
 #[derive(Clone, Debug, Default)]
 struct IpstPairs<const D: usize> {
+    /// Where each particle's pairs end.
+    end: Vec<usize>,
     j: Vec<u32>,
     xij: Vec<Vector<D>>,
     /// |x_ij|^2, then |x_ij|.
@@ -409,22 +422,22 @@ struct IpstPairs<const D: usize> {
 }
 
 impl<const D: usize> IpstPairs<D> {
-    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)` of particle `i` at positions `xs`, over the
-    /// fluid (volumes `vol`) and the walls (with theirs).
-    fn sums(
+    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (volumes `vol`)
+    /// and the walls (with theirs).
+    fn evaluate(
         &mut self,
-        i: usize,
+        particles: std::ops::Range<usize>,
         xs: &[Vector<D>],
         nl: &KernelList<D>,
         vol: &[f64],
         walls: Option<(&WallSet<D>, &[f64])>,
         k: &ScaledKernel,
-    ) -> (Vector<D>, f64) {
-        let n_fluid = nl.count(i);
-        let n = n_fluid + walls.map_or(0, |(ws, _)| ws.fluid_to_wall.count(i));
-        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so a
-        // particle's padding holds an earlier particle's (finite) values, ignored below.
-        let padded = n.next_multiple_of(8);
+    ) {
+        let to_wall = walls.map(|(ws, _)| &ws.fluid_to_wall);
+        let n: usize = particles.clone().map(|i| nl.count(i) + to_wall.map_or(0, |l| l.count(i))).sum();
+        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
+        // padding holds earlier (finite) values, which no sum reads.
+        let padded = n.next_multiple_of(LANES);
         if self.r.len() < padded {
             self.j.resize(padded, 0);
             self.xij.resize(padded, Vector::zeros());
@@ -432,16 +445,22 @@ impl<const D: usize> IpstPairs<D> {
                 a.resize(padded, 0.0);
             }
         }
-        nl.write_pairs(i, xs[i], xs, &mut self.j, &mut self.xij, &mut self.r);
-        for (v, &j) in self.vol[..n_fluid].iter_mut().zip(&self.j) {
-            *v = vol[j as usize];
-        }
-        if let Some((ws, wall_vol)) = walls {
-            let (j, xij, r) = (&mut self.j[n_fluid..], &mut self.xij[n_fluid..], &mut self.r[n_fluid..]);
-            ws.fluid_to_wall.write_pairs(i, xs[i], &ws.wall.x, j, xij, r);
-            for (v, &j) in self.vol[n_fluid..n].iter_mut().zip(&self.j[n_fluid..]) {
-                *v = wall_vol[j as usize];
+        self.end.clear();
+        let mut at = 0;
+        for i in particles {
+            let mut write = |list: &KernelList<D>, sources: &[Vector<D>], vol: &[f64]| {
+                let to = at + list.count(i);
+                list.write_pairs(i, xs[i], sources, &mut self.j[at..], &mut self.xij[at..], &mut self.r[at..]);
+                for (v, &j) in self.vol[at..to].iter_mut().zip(&self.j[at..to]) {
+                    *v = vol[j as usize];
+                }
+                at = to;
+            };
+            write(nl, xs, vol);
+            if let Some((ws, wall_vol)) = walls {
+                write(&ws.fluid_to_wall, &ws.wall.x, wall_vol);
             }
+            self.end.push(at);
         }
         let r = &mut self.r[..padded];
         for r in r.iter_mut() {
@@ -453,10 +472,18 @@ impl<const D: usize> IpstPairs<D> {
             *f = shifting::ipst_weight(v, *w, r);
             *w = shifting::ipst_chi(k.h, *w);
         }
+    }
+
+    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)` of the `l`-th particle of the group last
+    /// evaluated.
+    #[inline(always)]
+    fn sums(&self, l: usize) -> (Vector<D>, f64) {
+        let from = if l == 0 { 0 } else { self.end[l - 1] };
+        let to = self.end[l];
         let (mut d, mut chi) = (Vector::<D>::zeros(), 0.0);
-        for m in 0..n {
-            d += self.xij[m] * self.weight[m];
-            chi += self.w[m];
+        for ((&xij, &f), &w) in self.xij[from..to].iter().zip(&self.weight[from..to]).zip(&self.w[from..to]) {
+            d += xij * f;
+            chi += w;
         }
         (d, chi)
     }
