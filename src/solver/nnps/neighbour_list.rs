@@ -17,6 +17,19 @@ const CHUNK: usize = 512;
 const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
 
+/// Where [`NeighbourList::write_pairs`] writes one point's pairs: neighbour indices,
+/// differences `x_ij`, `|x_ij|^2` and a value per neighbour.
+pub struct PairSlices<'a, const D: usize> {
+    /// Neighbour indices.
+    pub j: &'a mut [u32],
+    /// `x_i - x_j`, through the periodic image the pair was found through.
+    pub xij: &'a mut [Vector<D>],
+    /// `|x_ij|^2`.
+    pub r2: &'a mut [f64],
+    /// The neighbours' values.
+    pub value: &'a mut [f64],
+}
+
 #[derive(Clone, Debug, Default)]
 struct Chunk<const D: usize, P> {
     start: Vec<u32>,
@@ -253,28 +266,24 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     }
 
     /// Writes the neighbours of query point `i` at `xi` into the first
-    /// [`count(i)`](Self::count) elements of `j`, their differences `x_ij` into `xij` and
-    /// `|x_ij|^2` into `r2`, as [`for_each_from`](Self::for_each_from) visits them: the pairs
-    /// as arrays, for passes that evaluate them in vectorised loops. Panics if a slice is
-    /// shorter than the count.
+    /// [`count(i)`](Self::count) elements of `out`, as [`for_each_from`](Self::for_each_from)
+    /// visits them, with `values[j]` of each neighbour `j` (e.g. its volume): the pairs as
+    /// arrays, for passes that evaluate them in vectorised loops. Panics if a slice of
+    /// `out` is shorter than the count.
     #[inline(always)]
-    pub fn write_pairs(
-        &self,
-        i: usize,
-        xi: Vector<D>,
-        points: &[Vector<D>],
-        j: &mut [u32],
-        xij: &mut [Vector<D>],
-        r2: &mut [f64],
-    ) {
+    pub fn write_pairs(&self, i: usize, xi: Vector<D>, points: &[Vector<D>], values: &[f64], out: PairSlices<D>) {
         let chunk = &self.chunks[i / CHUNK];
         let l = i % CHUNK;
         let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
         let n = entries.len();
-        for (((&e, j), xij), r2) in entries.iter().zip(&mut j[..n]).zip(&mut xij[..n]).zip(&mut r2[..n]) {
+        let PairSlices { j, xij, r2, value } = out;
+        for ((((&e, j), xij), r2), value) in
+            entries.iter().zip(&mut j[..n]).zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n])
+        {
             *j = e & J_MASK;
             *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[*j as usize];
             *r2 = xij.norm_squared();
+            *value = values[*j as usize];
         }
     }
 

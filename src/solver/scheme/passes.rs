@@ -9,7 +9,7 @@ use crate::solver::equations::{
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
-use crate::solver::nnps::{CellList, NeighbourList};
+use crate::solver::nnps::{CellList, NeighbourList, PairSlices};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -449,12 +449,14 @@ impl<const D: usize> IpstPairs<D> {
         let mut at = 0;
         for i in particles {
             let mut write = |list: &KernelList<D>, sources: &[Vector<D>], vol: &[f64]| {
-                let to = at + list.count(i);
-                list.write_pairs(i, xs[i], sources, &mut self.j[at..], &mut self.xij[at..], &mut self.r[at..]);
-                for (v, &j) in self.vol[at..to].iter_mut().zip(&self.j[at..to]) {
-                    *v = vol[j as usize];
-                }
-                at = to;
+                let out = PairSlices {
+                    j: &mut self.j[at..],
+                    xij: &mut self.xij[at..],
+                    r2: &mut self.r[at..],
+                    value: &mut self.vol[at..],
+                };
+                list.write_pairs(i, xs[i], sources, vol, out);
+                at += list.count(i);
             };
             write(nl, xs, vol);
             if let Some((ws, wall_vol)) = walls {
