@@ -17,11 +17,9 @@ const CHUNK: usize = 512;
 const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
 
-/// Where [`NeighbourList::write_pairs`] writes one point's pairs: neighbour indices,
-/// differences `x_ij`, `|x_ij|^2` and a value per neighbour.
+/// Where [`NeighbourList::write_pairs`] writes one point's pairs: the differences `x_ij`,
+/// `|x_ij|^2` and a value per neighbour.
 pub struct PairSlices<'a, const D: usize> {
-    /// Neighbour indices.
-    pub j: &'a mut [u32],
     /// `x_i - x_j`, through the periodic image the pair was found through.
     pub xij: &'a mut [Vector<D>],
     /// `|x_ij|^2`.
@@ -276,14 +274,12 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let l = i % CHUNK;
         let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
         let n = entries.len();
-        let PairSlices { j, xij, r2, value } = out;
-        for ((((&e, j), xij), r2), value) in
-            entries.iter().zip(&mut j[..n]).zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n])
-        {
-            *j = e & J_MASK;
-            *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[*j as usize];
+        let PairSlices { xij, r2, value } = out;
+        for (((&e, xij), r2), value) in entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]) {
+            let j = (e & J_MASK) as usize;
+            *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[j];
             *r2 = xij.norm_squared();
-            *value = values[*j as usize];
+            *value = values[j];
         }
     }
 

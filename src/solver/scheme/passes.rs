@@ -412,7 +412,6 @@ const LANES: usize = 8;
 struct IpstPairs<const D: usize> {
     /// Where each particle's pairs end.
     end: Vec<usize>,
-    j: Vec<u32>,
     xij: Vec<Vector<D>>,
     /// |x_ij|^2, then |x_ij|.
     r: Vec<f64>,
@@ -439,7 +438,6 @@ impl<const D: usize> IpstPairs<D> {
         // padding holds earlier (finite) values, which no sum reads.
         let padded = n.next_multiple_of(LANES);
         if self.r.len() < padded {
-            self.j.resize(padded, 0);
             self.xij.resize(padded, Vector::zeros());
             for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.weight] {
                 a.resize(padded, 0.0);
@@ -450,7 +448,6 @@ impl<const D: usize> IpstPairs<D> {
         for i in particles {
             let mut write = |list: &KernelList<D>, sources: &[Vector<D>], vol: &[f64]| {
                 let out = PairSlices {
-                    j: &mut self.j[at..],
                     xij: &mut self.xij[at..],
                     r2: &mut self.r[at..],
                     value: &mut self.vol[at..],
