@@ -329,6 +329,19 @@ mod tests {
                 });
                 v.sort();
                 assert_eq!(v, brute[i], "point {i}");
+                // The same pairs as arrays, at moved positions, with a value per neighbour.
+                let moved: Vec<Vector<2>> = pts.iter().map(|x| x * 1.001).collect();
+                let values: Vec<f64> = (0..pts.len()).map(|j| j as f64).collect();
+                let n = nl.count(i);
+                assert_eq!(n, brute[i].len());
+                let (mut xij, mut r2, mut value) = (vec![Vector::zeros(); n], vec![0.0; n], vec![0.0; n]);
+                let out = PairSlices { xij: &mut xij, r2: &mut r2, value: &mut value };
+                nl.write_pairs(i, moved[i], &moved, &values, out);
+                let mut k = 0;
+                nl.for_each(i, &moved, |j, x, d2, _| {
+                    assert_eq!((xij[k], r2[k], value[k]), (x, d2, j as f64));
+                    k += 1;
+                });
             }
             assert_eq!(nl.pairs(), brute.iter().map(|v| v.len()).sum::<usize>());
         }
