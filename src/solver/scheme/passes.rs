@@ -355,17 +355,17 @@ impl<const D: usize> FluidPasses<D> {
             let xs: &[Vector<D>] = &self.x_shift;
             // In fixed blocks of particles, each with its own pair arrays kept from step to
             // step (so that the sweeps allocate nothing once they have grown).
-            self.ipst_pairs.resize_with(n.div_ceil(MIN_LEN), IpstPairs::default);
+            self.ipst_pairs.resize_with(n.div_ceil(IPST_BLOCK), IpstPairs::default);
             // Each block returns its largest chi (max is exact: any grouping gives the same).
             let chi_max = self
                 .x_next
-                .par_chunks_mut(MIN_LEN)
+                .par_chunks_mut(IPST_BLOCK)
                 .zip(self.ipst_pairs.par_iter_mut())
                 .enumerate()
                 .map(|(c, (next, pairs))| {
                     let mut chi_max = f64::MIN;
                     for (g, next) in next.chunks_mut(IPST_GROUP).enumerate() {
-                        let first = c * MIN_LEN + g * IPST_GROUP;
+                        let first = c * IPST_BLOCK + g * IPST_GROUP;
                         pairs.evaluate(first..first + next.len(), xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
                         for (l, next) in next.iter_mut().enumerate() {
                             let i = first + l;
@@ -398,6 +398,9 @@ impl<const D: usize> FluidPasses<D> {
     }
 }
 
+/// Particles per IPST task, each with its own pair arrays (kept from step to step): more
+/// than the passes' `MIN_LEN`, so that the arrays cost a few bytes per particle.
+const IPST_BLOCK: usize = 256;
 /// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
 /// cache level, and the vectorised loops run over the group's pairs, padded once.
 const IPST_GROUP: usize = 8;
