@@ -49,7 +49,7 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
             ipst_max_iter: 10,
             gravity: [0.0; 3],
             internal_flow: true,
-            free_surface: false,
+            free_surface: None,
         };
         let s = scheme.fluid_scheme(&settings);
         let fluid = Fluid::new("fluid", dx, init.clone(), s.transport.is_some()).unwrap();

@@ -6,7 +6,9 @@ use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
 use crate::solver::particles::{Fluid, FluidInit, Wall};
-use crate::solver::scheme::{Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName};
+use crate::solver::scheme::{
+    Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName, SurfacePressure,
+};
 use crate::solver::simulation::Simulation;
 use std::path::Path;
 
@@ -47,6 +49,16 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
         ),
         Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
     ]
+}
+
+/// The parameters of a scene with a free surface (on top of [`scheme_params`]).
+pub fn free_surface_params() -> Vec<Spec> {
+    vec![Spec::choice(
+        "surface_pressure",
+        SurfacePressure::NAMES,
+        "evolve",
+        "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), or evolved but not below 0",
+    )]
 }
 
 fn switch(p: &Params, key: &str, all: bool) -> bool {
@@ -156,7 +168,10 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
         ipst_max_iter: p.int("ipst_max_iter") as usize,
         gravity: c.gravity,
         internal_flow: c.internal_flow,
-        free_surface: c.free_surface,
+        free_surface: c.free_surface.then(|| {
+            SurfacePressure::from_name(p.str("surface_pressure"))
+                .expect("checked choice (free_surface_params)")
+        }),
     };
     let scheme = SchemeName::from_name(p.str("scheme")).expect("checked choice").fluid_scheme(&settings);
     (kernel, h, scheme)

@@ -7,8 +7,8 @@
 //! (outer-layer particles not found).
 
 use super::common::{
-    fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies,
-    wall_from, FluidConstants,
+    fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim, scheme_params,
+    snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -43,6 +43,7 @@ fn params() -> Vec<Spec> {
         Spec::float("dx", 0.05, Bound::Positive, "particle spacing (m)"),
     ];
     v.extend(scheme_params("none"));
+    v.extend(free_surface_params());
     v.extend(common_params(1e-4));
     v
 }

@@ -10,8 +10,8 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, require_free_surface_scheme,
-    restore_sim, scheme_params, snapshot_bodies, wall_from, FluidConstants,
+    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
+    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -44,6 +44,7 @@ fn params() -> Vec<Spec> {
         Spec::float("alpha", 0.05, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
     ];
     v.extend(scheme_params("none"));
+    v.extend(free_surface_params());
     v.extend(common_params(2.0));
     v
 }

@@ -7,7 +7,7 @@ use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
-    Shifting, SurfaceFields, WallSet,
+    Shifting, SurfaceFields, SurfacePressure, WallSet,
 };
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -264,8 +264,13 @@ impl<const D: usize> Simulation<D> {
     fn evaluate_accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
         let (st, walls) = (&mut self.state, self.walls.as_ref());
-        if let (Some(fs), Some(rho0)) = (self.surface.as_mut(), st.scheme.free_surface) {
-            fs.detect(&st.fluid, &self.neighbours, walls, rho0);
+        if let (Some(fs), Some(free)) = (self.surface.as_mut(), st.scheme.free_surface) {
+            fs.detect(&st.fluid, &self.neighbours, walls, free.rho0);
+            match free.pressure {
+                SurfacePressure::Zero => fs.limit_pressure(&mut st.fluid.p, |_| 0.0),
+                SurfacePressure::NonNegative => fs.limit_pressure(&mut st.fluid.p, |p| p.max(0.0)),
+                SurfacePressure::Evolve => {}
+            }
         }
         let surface = self.surface.as_ref();
         self.passes.accelerations(

@@ -269,13 +269,22 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     /// arrays, for passes that evaluate them in vectorised loops. Panics if a slice of
     /// `out` is shorter than the count.
     #[inline(always)]
-    pub fn write_pairs(&self, i: usize, xi: Vector<D>, points: &[Vector<D>], values: &[f64], out: PairSlices<D>) {
+    pub fn write_pairs(
+        &self,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        values: &[f64],
+        out: PairSlices<D>,
+    ) {
         let chunk = &self.chunks[i / CHUNK];
         let l = i % CHUNK;
         let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
         let n = entries.len();
         let PairSlices { xij, r2, value } = out;
-        for (((&e, xij), r2), value) in entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]) {
+        for (((&e, xij), r2), value) in
+            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n])
+        {
             let j = (e & J_MASK) as usize;
             *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[j];
             *r2 = xij.norm_squared();

@@ -7,6 +7,7 @@ use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal,
 use crate::solver::equations::{Pair, Point};
 use crate::solver::math::Vector;
 use crate::solver::particles::Fluid;
+use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 
 /// Per-particle free-surface state of one fluid.
@@ -100,5 +101,30 @@ impl<const D: usize> SurfaceFields<D> {
             }
             *out = near;
         });
+    }
+
+    /// Replaces the pressure `p` of each surface particle by `f(p)` (see
+    /// [`SurfacePressure`](super::SurfacePressure)).
+    pub fn limit_pressure(&self, p: &mut [f64], f: impl Fn(f64) -> f64 + Sync) {
+        p.par_iter_mut().zip(&self.surface).with_min_len(LIGHT_LOOP_LEN).for_each(|(p, &s)| {
+            if s {
+                *p = f(*p);
+            }
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn surface_pressure_limits_touch_surface_particles_only() {
+        let fs = SurfaceFields::<2> { surface: vec![true, false, true], ..Default::default() };
+        let mut p = vec![-3.0, -2.0, 5.0];
+        fs.limit_pressure(&mut p, |p| p.max(0.0));
+        assert_eq!(p, [0.0, -2.0, 5.0]);
+        fs.limit_pressure(&mut p, |_| 0.0);
+        assert_eq!(p, [0.0, -2.0, 0.0]);
     }
 }

@@ -75,6 +75,51 @@ impl Pst {
     }
 }
 
+/// What the pressure of the free-surface particles (sec. 3.4) does. The paper's text
+/// evolves every particle's pressure by eq. (26); the authors' public PySPH code can also
+/// zero p and dp/dt of the surface particles. In the dam break at dx = 0.02 (2026-11-22)
+/// neither is robust: with `Evolve` an isolated droplet can hold a tension of -4e6 Pa and
+/// blow up (IPST at t = 2.38 s; SPST at t = 2.14 s in one domain, not in another), with
+/// `Zero` a surface particle meets a wall without pressure and goes through it (IPST,
+/// t = 1.35 s), and `NonNegative` throws drops out at 20 m/s.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfacePressure {
+    /// Evolved by eq. (26) like every other particle's (the paper's text).
+    Evolve,
+    /// Held at zero each step once the surface is detected: the dynamic condition of a
+    /// free surface, p = p_atm = 0.
+    Zero,
+    /// Evolved by eq. (26), but not below zero: a surface particle cannot pull (hold a
+    /// tension), but still pushes.
+    NonNegative,
+}
+
+impl SurfacePressure {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["evolve", "zero", "non_negative"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "zero" => Self::Zero,
+            "non_negative" => Self::NonNegative,
+            "evolve" => Self::Evolve,
+            _ => return None,
+        })
+    }
+}
+
+/// A free surface: detected every step (sec. 3.4), the shifting kept tangential near it
+/// (sec. 3.5).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FreeSurface {
+    /// The fluid's reference density, for the low-density rule of the detection.
+    pub rho0: f64,
+    /// What the surface particles' pressure does.
+    pub pressure: SurfacePressure,
+}
+
 /// The CTVF correction terms, each a switch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Corrections {
@@ -199,9 +244,8 @@ pub struct FluidScheme {
     pub transport: Option<Transport>,
     /// Body force per unit mass (x, y, z; the first D components are used).
     pub gravity: [f64; 3],
-    /// A free surface, detected every step (sec. 3.4), with the fluid's reference density
-    /// for the low-density rule; the shifting is then kept tangential near it (sec. 3.5).
-    pub free_surface: Option<f64>,
+    /// A free surface, if any.
+    pub free_surface: Option<FreeSurface>,
 }
 
 /// What a scene gives a scheme name to build a [`FluidScheme`] from.
@@ -238,8 +282,8 @@ pub struct FluidSettings {
     /// An internal flow (no free surface): the pressure level is arbitrary, so the
     /// pressure gradient uses the local mean-pressure correction (BQL).
     pub internal_flow: bool,
-    /// A free surface to detect (sec. 3.4-3.5).
-    pub free_surface: bool,
+    /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
+    pub free_surface: Option<SurfacePressure>,
 }
 
 impl SchemeName {
@@ -301,7 +345,7 @@ impl SchemeName {
                     artificial_viscosity,
                     transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
                     gravity: s.gravity,
-                    free_surface: s.free_surface.then_some(s.rho0),
+                    free_surface: s.free_surface.map(|pressure| FreeSurface { rho0: s.rho0, pressure }),
                 }
             }
         }
@@ -372,10 +416,15 @@ impl fmt::Display for FluidScheme {
         if g.iter().any(|&v| v != 0.0) {
             writeln!(f, "  gravity      {g:?}")?;
         }
-        if self.free_surface.is_some() {
+        if let Some(fs) = self.free_surface {
+            let p = match fs.pressure {
+                SurfacePressure::Zero => "held at 0",
+                SurfacePressure::NonNegative => "evolved by eq. (26), not below 0",
+                SurfacePressure::Evolve => "evolved by eq. (26)",
+            };
             writeln!(
                 f,
-                "  surface      detected every step (sec. 3.4); shifting tangential near it (eqs. 44-45)"
+                "  surface      detected every step (sec. 3.4); shifting tangential near it (eqs. 44-45); its pressure {p}"
             )?;
         }
         Ok(())

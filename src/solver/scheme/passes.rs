@@ -366,7 +366,14 @@ impl<const D: usize> FluidPasses<D> {
                     let mut chi_max = f64::MIN;
                     for (g, next) in next.chunks_mut(IPST_GROUP).enumerate() {
                         let first = c * IPST_BLOCK + g * IPST_GROUP;
-                        pairs.evaluate(first..first + next.len(), xs, nl, vol, walls.map(|ws| (ws, &wall_vol[..])), &k);
+                        pairs.evaluate(
+                            first..first + next.len(),
+                            xs,
+                            nl,
+                            vol,
+                            walls.map(|ws| (ws, &wall_vol[..])),
+                            &k,
+                        );
                         for (l, next) in next.iter_mut().enumerate() {
                             let i = first + l;
                             let (d, chi) = pairs.sums(l);
