@@ -57,7 +57,7 @@ pub fn free_surface_params() -> Vec<Spec> {
         "surface_pressure",
         SurfacePressure::NAMES,
         "evolve",
-        "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), or evolved but not below 0",
+        "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), held at 0 where isolated, or evolved but not below 0",
     )]
 }
 

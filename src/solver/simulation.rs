@@ -7,7 +7,7 @@ use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
     build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
-    Shifting, SurfaceFields, SurfacePressure, WallSet,
+    Shifting, SurfaceFields, WallSet,
 };
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -266,11 +266,7 @@ impl<const D: usize> Simulation<D> {
         let (st, walls) = (&mut self.state, self.walls.as_ref());
         if let (Some(fs), Some(free)) = (self.surface.as_mut(), st.scheme.free_surface) {
             fs.detect(&st.fluid, &self.neighbours, walls, free.rho0);
-            match free.pressure {
-                SurfacePressure::Zero => fs.limit_pressure(&mut st.fluid.p, |_| 0.0),
-                SurfacePressure::NonNegative => fs.limit_pressure(&mut st.fluid.p, |p| p.max(0.0)),
-                SurfacePressure::Evolve => {}
-            }
+            fs.apply_surface_pressure(free.pressure, free.rho0, &mut st.fluid.p);
         }
         let surface = self.surface.as_ref();
         self.passes.accelerations(

@@ -2,13 +2,17 @@
 //! the particles next to them, recomputed every step for fluids that declare a free surface.
 
 use super::passes::KernelList;
-use super::WallSet;
+use super::{SurfacePressure, WallSet};
 use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal, smoothed_normal};
 use crate::solver::equations::{Pair, Point};
 use crate::solver::math::Vector;
 use crate::solver::particles::Fluid;
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
+
+/// A particle whose summation density (over fluid and walls) is below this fraction of the
+/// reference density is isolated, away from the bulk (sec. 3.4): a surface particle.
+const ISOLATED: f64 = 0.5;
 
 /// Per-particle free-surface state of one fluid.
 #[derive(Clone, Debug, Default)]
@@ -73,7 +77,7 @@ impl<const D: usize> SurfaceFields<D> {
         let (normals, rho_sum) = (&self.normal, &self.rho_sum);
         self.surface.par_iter_mut().enumerate().for_each(|(i, out)| {
             let na = normals[i];
-            if rho_sum[i] < 0.5 * rho0 {
+            if rho_sum[i] < ISOLATED * rho0 {
                 *out = true;
                 return;
             }
@@ -103,14 +107,19 @@ impl<const D: usize> SurfaceFields<D> {
         });
     }
 
-    /// Replaces the pressure `p` of each surface particle by `f(p)` (see
-    /// [`SurfacePressure`](super::SurfacePressure)).
-    pub fn limit_pressure(&self, p: &mut [f64], f: impl Fn(f64) -> f64 + Sync) {
-        p.par_iter_mut().zip(&self.surface).with_min_len(LIGHT_LOOP_LEN).for_each(|(p, &s)| {
-            if s {
-                *p = f(*p);
-            }
-        });
+    /// Applies `mode` to the pressure `p` of the surface particles (the fluid's reference
+    /// density `rho0` tells the isolated ones).
+    pub fn apply_surface_pressure(&self, mode: SurfacePressure, rho0: f64, p: &mut [f64]) {
+        let rule = |i: usize, p: f64| match mode {
+            SurfacePressure::Evolve => p,
+            SurfacePressure::Zero if self.surface[i] => 0.0,
+            SurfacePressure::ZeroIsolated if self.rho_sum[i] < ISOLATED * rho0 => 0.0,
+            SurfacePressure::NonNegative if self.surface[i] => p.max(0.0),
+            _ => p,
+        };
+        if mode != SurfacePressure::Evolve {
+            p.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, p)| *p = rule(i, *p));
+        }
     }
 }
 
@@ -119,12 +128,22 @@ mod tests {
     use super::*;
 
     #[test]
-    fn surface_pressure_limits_touch_surface_particles_only() {
-        let fs = SurfaceFields::<2> { surface: vec![true, false, true], ..Default::default() };
-        let mut p = vec![-3.0, -2.0, 5.0];
-        fs.limit_pressure(&mut p, |p| p.max(0.0));
-        assert_eq!(p, [0.0, -2.0, 5.0]);
-        fs.limit_pressure(&mut p, |_| 0.0);
-        assert_eq!(p, [0.0, -2.0, 0.0]);
+    fn surface_pressure_modes_touch_the_particles_they_name() {
+        // Surface particles 0, 2 and 3; particle 3 is isolated (summation density < rho0 / 2).
+        let fs = SurfaceFields::<2> {
+            surface: vec![true, false, true, true],
+            rho_sum: vec![900.0, 1000.0, 700.0, 300.0],
+            ..Default::default()
+        };
+        let p0 = [-3.0, -2.0, 5.0, -4.0];
+        let apply = |mode| {
+            let mut p = p0.to_vec();
+            fs.apply_surface_pressure(mode, 1000.0, &mut p);
+            p
+        };
+        assert_eq!(apply(SurfacePressure::Evolve), p0);
+        assert_eq!(apply(SurfacePressure::Zero), [0.0, -2.0, 0.0, 0.0]);
+        assert_eq!(apply(SurfacePressure::ZeroIsolated), [-3.0, -2.0, 5.0, 0.0]);
+        assert_eq!(apply(SurfacePressure::NonNegative), [0.0, -2.0, 5.0, 0.0]);
     }
 }

@@ -77,11 +77,12 @@ impl Pst {
 
 /// What the pressure of the free-surface particles (sec. 3.4) does. The paper's text
 /// evolves every particle's pressure by eq. (26); the authors' public PySPH code can also
-/// zero p and dp/dt of the surface particles. In the dam break at dx = 0.02 (2026-11-22)
-/// neither is robust: with `Evolve` an isolated droplet can hold a tension of -4e6 Pa and
-/// blow up (IPST at t = 2.38 s; SPST at t = 2.14 s in one domain, not in another), with
-/// `Zero` a surface particle meets a wall without pressure and goes through it (IPST,
-/// t = 1.35 s), and `NonNegative` throws drops out at 20 m/s.
+/// zero p and dp/dt of the surface particles. In the dam break at dx = 0.02 (measured
+/// 2026-11-22, to t = 2.5 s) none is robust: with `Evolve` an isolated droplet can hold a
+/// tension of -4e6 Pa and blow up (IPST at t = 2.38 s); with `Zero` a surface particle
+/// meets a wall without pressure and goes through it (IPST, t = 1.35 s); `ZeroIsolated`
+/// completes IPST and SPST with corrections but throws a drop 4 m out of the tank without
+/// them; `NonNegative` throws drops out in all three.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SurfacePressure {
@@ -90,6 +91,9 @@ pub enum SurfacePressure {
     /// Held at zero each step once the surface is detected: the dynamic condition of a
     /// free surface, p = p_atm = 0.
     Zero,
+    /// Held at zero for the isolated particles only (summation density below half the
+    /// reference, the rule of sec. 3.4): drops in flight, whose pressure means nothing.
+    ZeroIsolated,
     /// Evolved by eq. (26), but not below zero: a surface particle cannot pull (hold a
     /// tension), but still pushes.
     NonNegative,
@@ -97,12 +101,13 @@ pub enum SurfacePressure {
 
 impl SurfacePressure {
     /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["evolve", "zero", "non_negative"];
+    pub const NAMES: &'static [&'static str] = &["evolve", "zero", "zero_isolated", "non_negative"];
 
     /// Parses a name from `NAMES`.
     pub fn from_name(s: &str) -> Option<Self> {
         Some(match s {
             "zero" => Self::Zero,
+            "zero_isolated" => Self::ZeroIsolated,
             "non_negative" => Self::NonNegative,
             "evolve" => Self::Evolve,
             _ => return None,
@@ -419,6 +424,7 @@ impl fmt::Display for FluidScheme {
         if let Some(fs) = self.free_surface {
             let p = match fs.pressure {
                 SurfacePressure::Zero => "held at 0",
+                SurfacePressure::ZeroIsolated => "held at 0 where isolated",
                 SurfacePressure::NonNegative => "evolved by eq. (26), not below 0",
                 SurfacePressure::Evolve => "evolved by eq. (26)",
             };
