@@ -17,6 +17,12 @@ const CHUNK: usize = 512;
 const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
 
+/// The code of a periodic image, `wraps` (each in -1..=1) in base 3: an index into the
+/// list's image shifts.
+fn image_code<const D: usize>(wraps: [i8; D]) -> u32 {
+    wraps.iter().rev().fold(0, |code, &w| code * 3 + (w + 1) as u32)
+}
+
 /// Where [`NeighbourList::write_pairs`] writes one point's pairs: the differences `x_ij`,
 /// `|x_ij|^2` and a value per neighbour.
 pub struct PairSlices<'a, const D: usize> {
@@ -62,11 +68,11 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
     ) {
         self.candidates.clear();
         cells.for_each_cell_around(cell, |indices, wraps| {
-            let mut code = 0u32;
-            for k in (0..D).rev() {
-                debug_assert!((-1..=1).contains(&wraps[k]), "self-queries wrap by one period at most");
-                code = code * 3 + (wraps[k] + 1) as u32;
-            }
+            debug_assert!(
+                wraps.iter().all(|w| (-1..=1).contains(w)),
+                "self-queries wrap by one period at most"
+            );
+            let code = image_code(wraps);
             self.candidates.extend(indices.iter().map(|&j| j | (code << J_BITS)));
         });
         let m = self.candidates.len();
@@ -202,10 +208,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
             for q in &queries[c * CHUNK..((c + 1) * CHUNK).min(n)] {
                 chunk.start.push(chunk.entries.len() as u32);
                 cells.visit(sources, q, |j, _, r2, wraps| {
-                    let mut code = 0u32;
-                    for k in (0..D).rev() {
-                        code = code * 3 + (wraps[k].clamp(-1, 1) + 1) as u32;
-                    }
+                    let code = image_code(wraps.map(|w| w.clamp(-1, 1)));
                     chunk.entries.push(j as u32 | (code << J_BITS));
                     chunk.r2.push(r2);
                 });
@@ -245,22 +248,34 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         points: &[Vector<D>],
         mut f: F,
     ) {
-        let chunk = &self.chunks[i / CHUNK];
-        let l = i % CHUNK;
-        let range = chunk.start[l] as usize..chunk.start[l + 1] as usize;
+        let (chunk, range) = self.range(i);
         for (&e, p) in chunk.entries[range.clone()].iter().zip(&chunk.payload[range]) {
-            let j = (e & J_MASK) as usize;
-            let xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[j];
+            let (j, xij) = self.pair(e, xi, points);
             f(j, xij, xij.norm_squared(), p);
         }
+    }
+
+    /// The chunk holding point `i` and the range of its entries in it.
+    #[inline(always)]
+    fn range(&self, i: usize) -> (&Chunk<D, P>, std::ops::Range<usize>) {
+        let chunk = &self.chunks[i / CHUNK];
+        let l = i % CHUNK;
+        (chunk, chunk.start[l] as usize..chunk.start[l + 1] as usize)
+    }
+
+    /// The neighbour of entry `e` and its difference `x_ij` from a query at `xi`, through
+    /// the entry's periodic image (the one formula every pass uses, so that all see the
+    /// same bits).
+    #[inline(always)]
+    fn pair(&self, e: u32, xi: Vector<D>, points: &[Vector<D>]) -> (usize, Vector<D>) {
+        let j = (e & J_MASK) as usize;
+        (j, (xi - self.shifts[(e >> J_BITS) as usize]) - points[j])
     }
 
     /// Number of neighbours of query point `i`.
     #[inline(always)]
     pub fn count(&self, i: usize) -> usize {
-        let chunk = &self.chunks[i / CHUNK];
-        let l = i % CHUNK;
-        (chunk.start[l + 1] - chunk.start[l]) as usize
+        self.range(i).1.len()
     }
 
     /// Writes the neighbours of query point `i` at `xi` into the first
@@ -277,16 +292,15 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         values: &[f64],
         out: PairSlices<D>,
     ) {
-        let chunk = &self.chunks[i / CHUNK];
-        let l = i % CHUNK;
-        let entries = &chunk.entries[chunk.start[l] as usize..chunk.start[l + 1] as usize];
+        let (chunk, range) = self.range(i);
+        let entries = &chunk.entries[range];
         let n = entries.len();
         let PairSlices { xij, r2, value } = out;
         for (((&e, xij), r2), value) in
             entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n])
         {
-            let j = (e & J_MASK) as usize;
-            *xij = (xi - self.shifts[(e >> J_BITS) as usize]) - points[j];
+            let j;
+            (j, *xij) = self.pair(e, xi, points);
             *r2 = xij.norm_squared();
             *value = values[j];
         }
