@@ -13,7 +13,7 @@
 //! outside the tank at the end (through a wall beyond its outer layer, or thrown over it);
 //! `max_penetration`, the deepest fluid particle beyond a wall surface but within its
 //! layers, in dx. `timeseries.csv`: `t, toe, t_star, toe_star, max_speed`, with the toe Z
-//! the largest x of the fluid, t* = t sqrt(2 g / L) and Z/L.
+//! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
     check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
