@@ -8,6 +8,7 @@
 
 mod free_surface;
 mod passes;
+mod plan;
 mod walls;
 
 pub use free_surface::SurfaceFields;

@@ -3,6 +3,7 @@
 //! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
 //! for any number of threads.
 
+use super::plan::{self, with_plan};
 use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, SurfaceFields, WallSet};
 use crate::solver::equations::{
     artificial_viscosity, continuity, edac, free_surface, momentum, shifting, viscosity, Pair, Point,
@@ -179,27 +180,12 @@ impl<const D: usize> FluidPasses<D> {
         dt: f64,
     ) {
         let continuity_on = s.density == DensityModel::Continuity;
-        let corr = s.transport.map(|t| t.corrections);
-        let continuity_corr = corr.is_some_and(|c| c.continuity);
-        let pressure_corr = corr.is_some_and(|c| c.pressure);
-        let edac = match s.pressure {
-            PressureModel::Edac { cs, nu } => Some((cs * cs, nu)),
-            PressureModel::StateEquation { .. } => None,
-        };
-        if continuity_on || edac.is_some() {
+        let terms = RateTerms::new(s);
+        if continuity_on || terms.plan & plan::EDAC != 0 {
             let src = self.gather(fluid, nl, walls);
-            let terms = RateTerms { edac, pressure_corr, continuity_on, continuity_corr };
-            let rate = |i: usize| -> (f64, f64) {
-                let a = &src.pts[i];
-                let mut sums = (0.0, 0.0);
-                src.for_each(
-                    i,
-                    #[inline(always)]
-                    |ab, b, _, _| terms.add(&mut sums, a, b, ab),
-                );
-                sums
-            };
-            match (edac.is_some(), continuity_on) {
+            let rate =
+                |i: usize| with_plan!(plan::RATES; terms.plan, P => terms.sums::<P, D>(&src, i); 0 1 2 3);
+            match (terms.plan & plan::EDAC != 0, continuity_on) {
                 (true, true) => rates
                     .dp
                     .par_iter_mut()
@@ -258,29 +244,15 @@ impl<const D: usize> FluidPasses<D> {
         let src = self.gather(fluid, nl, walls);
         let g = s.gravity_vector::<D>();
         let shifting = s.transport.map(|t| t.shifting);
-        let momentum_corr = s.transport.is_some_and(|t| t.corrections.momentum);
         let transport = s.transport.is_some();
         let sun_prefactor = match shifting {
             // -(Ma c0) 2h / dt, eq. (36)
             Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
             _ => 0.0,
         };
-        let terms = AccelTerms {
-            pressure_gradient: s.pressure_gradient,
-            viscosity: s.viscosity,
-            artificial_viscosity: s.artificial_viscosity,
-            transport,
-            momentum_corr,
-            shifting,
-        };
+        let terms = AccelTerms::new(s);
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
-            let a = &src.pts[i];
-            let mut sums = AccelSums::zero();
-            src.for_each(
-                i,
-                #[inline(always)]
-                |ab, b, b_visc, b_fluid| terms.add(&mut sums, a, ab, b, b_visc, b_fluid),
-            );
+            let sums = with_plan!(plan::ACCELERATIONS; terms.plan, P => terms.sums::<P, D>(&src, i); 0 1 2 3 4 5 6 7 8 9 10 11);
             let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
             // BQL: the gradient with the neighbour-mean pressure as reference; the mean is
             // constant over the sum, so it is applied once here (c_ref is zero without BQL).
@@ -525,30 +497,62 @@ pub fn ipst_chi_reference<const D: usize>(
     }
 }
 
-/// The terms of pass A a scheme declares. Their sum over one neighbour is an
-/// always-inlined method, so the per-particle sums stay in registers across the loops over
-/// the fluid and the walls.
+/// The terms of pass A a scheme declares: its plan and the EDAC constants.
 struct RateTerms {
-    /// EDAC's `(c_s^2, nu_edac)`, if the pressure evolves by EDAC.
-    edac: Option<(f64, f64)>,
-    pressure_corr: bool,
-    continuity_on: bool,
-    continuity_corr: bool,
+    plan: u32,
+    /// EDAC's `c_s^2` and `nu_edac`.
+    cs2: f64,
+    nu: f64,
 }
 
 impl RateTerms {
+    fn new(s: &FluidScheme) -> Self {
+        let corr = s.transport.map(|t| t.corrections);
+        let continuity = s.density == DensityModel::Continuity;
+        let (edac, cs2, nu) = match s.pressure {
+            PressureModel::Edac { cs, nu } => (true, cs * cs, nu),
+            PressureModel::StateEquation { .. } => (false, 0.0, 0.0),
+        };
+        let plan = plan::bit(edac, plan::EDAC)
+            | plan::bit(edac && corr.is_some_and(|c| c.pressure), plan::PRESSURE_CORR)
+            | plan::bit(continuity, plan::CONTINUITY)
+            | plan::bit(continuity && corr.is_some_and(|c| c.continuity), plan::CONTINUITY_CORR);
+        Self { plan, cs2, nu }
+    }
+
+    /// Particle `i`'s `(dp/dt, drho/dt)` under plan `P`: the sums stay in registers across
+    /// the loops over the fluid and the walls.
+    #[inline(always)]
+    fn sums<const P: u32, const D: usize>(&self, src: &Sources<'_, D>, i: usize) -> (f64, f64) {
+        let a = &src.pts[i];
+        let mut sums = (0.0, 0.0);
+        src.for_each(
+            i,
+            #[inline(always)]
+            |ab, b, _, _| self.add::<P, D>(&mut sums, a, b, ab),
+        );
+        sums
+    }
+
     /// Adds neighbour `b`'s share of `(dp/dt, drho/dt)` of particle `a`.
     #[inline(always)]
-    fn add<const D: usize>(&self, (dp, drho): &mut (f64, f64), a: &Point<D>, b: &Point<D>, ab: &Pair<D>) {
-        if let Some((cs2, nu)) = self.edac {
-            *dp += edac::compressibility(a, b, ab, cs2) + edac::diffusion(a, b, ab, nu);
-            if self.pressure_corr {
+    fn add<const P: u32, const D: usize>(
+        &self,
+        (dp, drho): &mut (f64, f64),
+        a: &Point<D>,
+        b: &Point<D>,
+        ab: &Pair<D>,
+    ) {
+        let has = |t| plan::has::<P>(self.plan, t);
+        if has(plan::EDAC) {
+            *dp += edac::compressibility(a, b, ab, self.cs2) + edac::diffusion(a, b, ab, self.nu);
+            if has(plan::PRESSURE_CORR) {
                 *dp += edac::transport_correction(a, b, ab);
             }
         }
-        if self.continuity_on {
+        if has(plan::CONTINUITY) {
             *drho += continuity::transport_divergence(a, b, ab);
-            if self.continuity_corr {
+            if has(plan::CONTINUITY_CORR) {
                 *drho += continuity::correction(a, b, ab);
             }
         }
@@ -574,21 +578,73 @@ impl<const D: usize> AccelSums<D> {
     }
 }
 
-/// The terms of pass B a scheme declares (see [`RateTerms`] for why a struct).
+/// The terms of pass B a scheme declares: the plan and the terms' constants.
 struct AccelTerms {
-    pressure_gradient: PressureGradient,
-    viscosity: Option<f64>,
-    artificial_viscosity: Option<(f64, f64)>,
-    transport: bool,
-    momentum_corr: bool,
-    shifting: Option<Shifting>,
+    plan: u32,
+    nu: f64,
+    /// Artificial viscosity `(alpha, c)`.
+    av: (f64, f64),
+    /// Background pressure.
+    pb: f64,
+    /// Sun 2019: `(W(dx), R, n)`.
+    sun: (f64, f64, i32),
 }
 
 impl AccelTerms {
+    fn new(s: &FluidScheme) -> Self {
+        let shifting = s.transport.map(|t| t.shifting);
+        let (adami, bql) = match s.pressure_gradient {
+            PressureGradient::Symmetric { bql } => (false, bql),
+            PressureGradient::Adami { bql } => (true, bql),
+        };
+        let plan = plan::bit(adami, plan::ADAMI)
+            | plan::bit(bql, plan::BQL)
+            | plan::bit(s.viscosity.is_some(), plan::VISCOSITY)
+            | plan::bit(s.artificial_viscosity.is_some(), plan::ARTIFICIAL_VISCOSITY)
+            | plan::bit(s.transport.is_some(), plan::TRANSPORT)
+            | plan::bit(s.transport.is_some_and(|t| t.corrections.momentum), plan::MOMENTUM_CORR)
+            | plan::bit(
+                matches!(shifting, Some(Shifting::BackgroundPressure { .. })),
+                plan::BACKGROUND_PRESSURE,
+            )
+            | plan::bit(matches!(shifting, Some(Shifting::Sun2019 { .. })), plan::SUN2019);
+        let (mut pb, mut sun) = (0.0, (0.0, 0.0, 0));
+        match shifting {
+            Some(Shifting::BackgroundPressure { pb: p }) => pb = p,
+            Some(Shifting::Sun2019 { w_dx, r, n, .. }) => sun = (w_dx, r, n),
+            _ => {}
+        }
+        Self {
+            plan,
+            nu: s.viscosity.unwrap_or(0.0),
+            av: s.artificial_viscosity.unwrap_or((0.0, 0.0)),
+            pb,
+            sun,
+        }
+    }
+
+    #[inline(always)]
+    fn has<const P: u32>(&self, t: u32) -> bool {
+        plan::has::<P>(self.plan, t)
+    }
+
+    /// Particle `i`'s sums over its sources under plan `P`.
+    #[inline(always)]
+    fn sums<const P: u32, const D: usize>(&self, src: &Sources<'_, D>, i: usize) -> AccelSums<D> {
+        let a = &src.pts[i];
+        let mut sums = AccelSums::zero();
+        src.for_each(
+            i,
+            #[inline(always)]
+            |ab, b, b_visc, b_fluid| self.add::<P, D>(&mut sums, a, ab, b, b_visc, b_fluid),
+        );
+        sums
+    }
+
     /// Adds neighbour `b`'s share: `b` as the divergence terms see it, `b_visc` as the
     /// viscous ones do (they differ for walls), `b_fluid` whether it is a fluid particle.
     #[inline(always)]
-    fn add<const D: usize>(
+    fn add<const P: u32, const D: usize>(
         &self,
         s: &mut AccelSums<D>,
         a: &Point<D>,
@@ -597,41 +653,37 @@ impl AccelTerms {
         b_visc: &Point<D>,
         b_fluid: bool,
     ) {
-        match self.pressure_gradient {
-            PressureGradient::Symmetric { bql } => {
-                s.acc += momentum::pressure_gradient(a, b, ab);
-                if bql {
-                    s.c_ref += momentum::pressure_reference_weight(a, b, ab);
-                }
+        if self.has::<P>(plan::ADAMI) {
+            s.acc += momentum::pressure_gradient_adami(a, b, ab);
+            if self.has::<P>(plan::BQL) {
+                s.c_ref += momentum::adami_weight(a, b, ab);
             }
-            PressureGradient::Adami { bql } => {
-                s.acc += momentum::pressure_gradient_adami(a, b, ab);
-                if bql {
-                    s.c_ref += momentum::adami_weight(a, b, ab);
-                }
+        } else {
+            s.acc += momentum::pressure_gradient(a, b, ab);
+            if self.has::<P>(plan::BQL) {
+                s.c_ref += momentum::pressure_reference_weight(a, b, ab);
             }
         }
         s.p_sum += b.p;
         s.n_nb += 1;
-        if let Some(nu) = self.viscosity {
-            s.acc += viscosity::morris(a, b_visc, ab, nu);
+        if self.has::<P>(plan::VISCOSITY) {
+            s.acc += viscosity::morris(a, b_visc, ab, self.nu);
         }
-        if let Some((alpha, c)) = self.artificial_viscosity {
-            s.acc += artificial_viscosity::monaghan(a, b_visc, ab, alpha, c);
+        if self.has::<P>(plan::ARTIFICIAL_VISCOSITY) {
+            s.acc += artificial_viscosity::monaghan(a, b_visc, ab, self.av.0, self.av.1);
         }
-        if self.transport {
+        if self.has::<P>(plan::TRANSPORT) {
             if b_fluid {
                 s.acc += momentum::artificial_stress(a, b, ab);
-                if self.momentum_corr {
+                if self.has::<P>(plan::MOMENTUM_CORR) {
                     s.acc += momentum::transport_divergence_correction(a, b, ab);
                 }
             }
-            match self.shifting {
-                Some(Shifting::BackgroundPressure { pb }) => {
-                    s.ac += shifting::background_pressure(a, b, ab, pb)
-                }
-                Some(Shifting::Sun2019 { w_dx, r, n, .. }) => s.ac += shifting::sun2019(b, ab, w_dx, r, n),
-                _ => {}
+            if self.has::<P>(plan::BACKGROUND_PRESSURE) {
+                s.ac += shifting::background_pressure(a, b, ab, self.pb);
+            } else if self.has::<P>(plan::SUN2019) {
+                let (w_dx, r, n) = self.sun;
+                s.ac += shifting::sun2019(b, ab, w_dx, r, n);
             }
         }
     }
@@ -639,4 +691,130 @@ impl AccelTerms {
 
 fn apply(v: &mut [f64], rate: &[f64], dt: f64) {
     v.par_iter_mut().zip(rate).with_min_len(LIGHT_LOOP_LEN).for_each(|(v, r)| *v += dt * r);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::scheme::{Corrections, FluidSettings, Pst, SchemeName, SurfacePressure};
+
+    /// Every plan the named schemes take on an internal flow (viscous) and a free surface
+    /// (artificial viscosity) has loops of its own: none falls back to run-time checks.
+    #[test]
+    fn named_schemes_run_compiled_plans() {
+        let internal = FluidSettings {
+            rho0: 1.0,
+            c0: 10.0,
+            u_ref: 1.0,
+            h: 0.02,
+            w_dx: 1.0,
+            nu: Some(0.01),
+            alpha: None,
+            edac_alpha: 0.5,
+            density: DensityModel::Summation,
+            pst: Pst::Sun,
+            corrections: Corrections::ALL,
+            ipst_tol: 0.02,
+            ipst_max_iter: 10,
+            gravity: [0.0; 3],
+            internal_flow: true,
+            free_surface: None,
+        };
+        let free_surface = FluidSettings {
+            nu: None,
+            alpha: Some(0.05),
+            density: DensityModel::Continuity,
+            internal_flow: false,
+            free_surface: Some(SurfacePressure::Evolve),
+            ..internal
+        };
+        let (mut accel, mut rates) = (Vec::new(), Vec::new());
+        for pst in [Pst::Sun, Pst::Ipst, Pst::None] {
+            for corrections in [Corrections::ALL, Corrections::NONE] {
+                for (flow, names) in [
+                    (internal, &[SchemeName::Edac, SchemeName::Tvf, SchemeName::Ctvf][..]),
+                    (free_surface, &[SchemeName::Ctvf][..]),
+                ] {
+                    for name in names {
+                        let scheme = name.fluid_scheme(&FluidSettings { pst, corrections, ..flow });
+                        let case = format!("{name:?} {pst:?} {corrections:?}");
+                        let b = AccelTerms::new(&scheme).plan;
+                        assert!(plan::ACCELERATIONS.contains(&b), "{case}: pass B plan {b:#b}");
+                        accel.push(b);
+                        let a = RateTerms::new(&scheme).plan;
+                        // Pass A runs for EDAC or the continuity equation (not tvf's state equation).
+                        if a != 0 {
+                            assert!(plan::RATES.contains(&a), "{case}: pass A plan {a:#b}");
+                            rates.push(a);
+                        }
+                    }
+                }
+            }
+        }
+        for plans in [&mut accel, &mut rates] {
+            plans.sort();
+            plans.dedup();
+        }
+        assert_eq!(accel.len(), plan::ACCELERATIONS.len(), "every compiled plan is one a named scheme takes");
+        assert_eq!(rates.len(), plan::RATES.len(), "every compiled plan is one a named scheme takes");
+    }
+
+    /// A compiled plan sums exactly what the run-time plan sums, bit for bit, in both
+    /// passes: on a perturbed periodic lattice with varied fields, for every compiled plan.
+    #[test]
+    fn compiled_plans_equal_the_run_time_plan() {
+        use crate::solver::kernel::KernelKind;
+        use crate::solver::nnps::Domain;
+        use crate::solver::particles::FluidInit;
+        let (n, dx) = (12, 1.0 / 12.0);
+        let h = dx;
+        let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
+        let x: Vec<Vector<2>> = (0..n * n)
+            .map(|k| {
+                Vector::<2>::new(
+                    ((k % n) as f64 + 0.5 + 0.2 * wave(k, 1.3)) * dx,
+                    ((k / n) as f64 + 0.5 + 0.2 * wave(k, 2.1)) * dx,
+                )
+            })
+            .collect();
+        let init = FluidInit {
+            u: (0..n * n).map(|k| Vector::<2>::new(wave(k, 0.7), wave(k, 1.9))).collect(),
+            m: vec![dx * dx; n * n],
+            rho: (0..n * n).map(|k| 1.0 + 0.05 * wave(k, 3.1)).collect(),
+            p: (0..n * n).map(|k| 2.0 * wave(k, 0.4)).collect(),
+            x,
+        };
+        let mut fluid = Fluid::new("f", h, init, true).unwrap();
+        for (k, uh) in fluid.u_hat.as_mut().unwrap().iter_mut().enumerate() {
+            *uh += Vector::<2>::new(0.1 * wave(k, 2.7), 0.1 * wave(k, 0.3));
+        }
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let mut cells = CellList::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel.support() * h);
+        cells.update(&fluid.x);
+        let mut nl = KernelList::new();
+        build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        let mut passes = FluidPasses::new();
+        let src = passes.gather(&fluid, &nl, None);
+        let accel = AccelTerms { plan: 0, nu: 0.01, av: (0.1, 10.0), pb: 100.0, sun: (2.0, 0.2, 4) };
+        let rates = RateTerms { plan: 0, cs2: 100.0, nu: 0.05 };
+        for &p in &plan::ACCELERATIONS {
+            let terms = AccelTerms { plan: p, ..accel };
+            for i in 0..fluid.len() {
+                let compiled = with_plan!(plan::ACCELERATIONS; p, P => terms.sums::<P, 2>(&src, i); 0 1 2 3 4 5 6 7 8 9 10 11);
+                let runtime = terms.sums::<{ plan::RUNTIME }, 2>(&src, i);
+                assert_eq!(
+                    (compiled.acc, compiled.ac, compiled.c_ref),
+                    (runtime.acc, runtime.ac, runtime.c_ref),
+                    "plan {p:#b}"
+                );
+            }
+        }
+        for &p in &plan::RATES {
+            let terms = RateTerms { plan: p, ..rates };
+            for i in 0..fluid.len() {
+                let compiled = with_plan!(plan::RATES; p, P => terms.sums::<P, 2>(&src, i); 0 1 2 3);
+                assert_eq!(compiled, terms.sums::<{ plan::RUNTIME }, 2>(&src, i), "plan {p:#b}");
+            }
+        }
+    }
 }
