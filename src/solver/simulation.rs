@@ -6,8 +6,8 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
-    build_kernel_list, ipst_chi_reference, DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel,
-    Shifting, SurfaceFields, WallSet,
+    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, DensityModel, FluidPasses,
+    FluidScheme, KernelList, PressureModel, Shifting, SurfaceFields, WallSet,
 };
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -63,9 +63,10 @@ pub struct State<const D: usize> {
 pub struct PhaseTimes {
     /// Kicks, drift and the blow-up check.
     pub integrate: f64,
-    /// Wrapping, binning, reordering and the neighbour list with its kernel values.
+    /// Wrapping, binning, reordering and the neighbour list with its kernel values (and
+    /// the fluid's share of a summation density, summed as the list is built).
     pub neighbours: f64,
-    /// Summation density.
+    /// Summation density: the walls' share.
     pub density: f64,
     /// Density and pressure rates and their update (pass A).
     pub pressure: f64,
@@ -113,6 +114,8 @@ pub struct Simulation<const D: usize> {
     pub surface: Option<SurfaceFields<D>>,
     cells: CellList<D>,
     neighbours: KernelList<D>,
+    /// The fluid's share of the summation density, summed as the list is built.
+    fluid_density: Vec<f64>,
     passes: FluidPasses<D>,
     /// Time per phase of the step, summed over the run.
     pub times: PhaseTimes,
@@ -156,6 +159,7 @@ impl<const D: usize> Simulation<D> {
             surface: scheme.free_surface.map(|_| SurfaceFields::default()),
             cells: CellList::new(domain, radius),
             neighbours: KernelList::new(),
+            fluid_density: Vec::new(),
             passes: FluidPasses::new(),
             times: PhaseTimes::default(),
         };
@@ -170,7 +174,7 @@ impl<const D: usize> Simulation<D> {
         sim.state.u_max = sim.max_speed();
         // Initial accelerations for the first half kick; the pressure is the initial one.
         if sim.state.scheme.density == DensityModel::Summation {
-            FluidPasses::summation_density(&mut sim.state.fluid, &sim.neighbours, sim.walls.as_ref());
+            FluidPasses::summation_density(&mut sim.state.fluid, &sim.fluid_density, sim.walls.as_ref());
         }
         if let PressureModel::StateEquation { .. } = sim.state.scheme.pressure {
             let st = &mut sim.state;
@@ -232,7 +236,12 @@ impl<const D: usize> Simulation<D> {
     /// The neighbour lists from the current binning, and the wall extrapolation.
     fn relist(&mut self) {
         let fluid = &self.state.fluid;
-        build_kernel_list(&mut self.neighbours, &self.cells, fluid, &self.kernel);
+        if self.state.scheme.density == DensityModel::Summation {
+            let rho = &mut self.fluid_density;
+            build_kernel_list_summing_density(&mut self.neighbours, &self.cells, fluid, &self.kernel, rho);
+        } else {
+            build_kernel_list(&mut self.neighbours, &self.cells, fluid, &self.kernel);
+        }
         if let Some(ws) = self.walls.as_mut() {
             ws.relist(fluid, &self.cells, &self.kernel);
         }
@@ -308,7 +317,7 @@ impl<const D: usize> Simulation<D> {
         {
             let (st, walls) = (&mut self.state, self.walls.as_ref());
             if st.scheme.density == DensityModel::Summation {
-                FluidPasses::summation_density(&mut st.fluid, &self.neighbours, walls);
+                FluidPasses::summation_density(&mut st.fluid, &self.fluid_density, walls);
                 clock = lap(clock, &mut self.times.density);
             }
             self.passes.update_density_and_pressure(

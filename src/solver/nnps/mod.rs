@@ -16,7 +16,7 @@ mod neighbour_list;
 
 pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
-pub use neighbour_list::{NeighbourList, PairSlices};
+pub use neighbour_list::{Listed, NeighbourList, PairSlices};
 
 use crate::solver::math::Vector;
 

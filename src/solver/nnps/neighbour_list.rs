@@ -34,6 +34,20 @@ pub struct PairSlices<'a, const D: usize> {
     pub value: &'a mut [f64],
 }
 
+/// One point's neighbours as just listed by [`NeighbourList::build_reducing`].
+pub struct Listed<'a, P> {
+    entries: &'a [u32],
+    payload: &'a [P],
+}
+
+impl<P> Listed<'_, P> {
+    /// The neighbours' indices and payloads, in the order of the list.
+    #[inline(always)]
+    pub fn iter(&self) -> impl Iterator<Item = (usize, &P)> {
+        self.entries.iter().map(|&e| (e & J_MASK) as usize).zip(self.payload)
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 struct Chunk<const D: usize, P> {
     start: Vec<u32>,
@@ -137,56 +151,75 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         points: &[Vector<D>],
         payload: impl Fn(&[f64], &mut [P]) + Sync,
     ) {
+        self.build_reducing(cells, points, payload, &mut vec![(); points.len()], |_| ());
+    }
+
+    /// As [`build`](Self::build), also reducing each point's pairs as soon as they are
+    /// listed, while they are in cache: `out[i] = reduce(neighbours of i)` (a summation
+    /// density, say, without a pass of its own). `out` must have one element per point.
+    pub fn build_reducing<R: Send>(
+        &mut self,
+        cells: &CellList<D>,
+        points: &[Vector<D>],
+        payload: impl Fn(&[f64], &mut [P]) + Sync,
+        out: &mut [R],
+        reduce: impl Fn(Listed<'_, P>) -> R + Sync,
+    ) {
         let n = points.len();
         assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
+        assert_eq!(out.len(), n, "one reduction per point");
         self.set_shifts(cells);
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         let shifts = &self.shifts;
         let r2max = cells.radius2();
         let simd = filter::simd_available();
-        self.chunks.par_iter_mut().enumerate().for_each(|(c, chunk)| {
-            chunk.clear();
-            // Points are visited in cell order, so the candidates of a cell serve every
-            // point in it.
-            let mut current = usize::MAX;
-            for i in c * CHUNK..((c + 1) * CHUNK).min(n) {
-                let cell = cells.cell_of(i);
-                if cell != current {
-                    current = cell;
-                    chunk.gather_candidates(cells, cell, points, shifts);
+        self.chunks.par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
+            |(c, (chunk, out))| {
+                chunk.clear();
+                // Points are visited in cell order, so the candidates of a cell serve every
+                // point in it.
+                let mut current = usize::MAX;
+                for (i, out) in (c * CHUNK..((c + 1) * CHUNK).min(n)).zip(out) {
+                    let cell = cells.cell_of(i);
+                    if cell != current {
+                        current = cell;
+                        chunk.gather_candidates(cells, cell, points, shifts);
+                    }
+                    let first = chunk.entries.len();
+                    chunk.start.push(first as u32);
+                    let m = chunk.candidates.len();
+                    // Room for every candidate plus one vector of lanes past the last.
+                    chunk.entries.resize(first + m + filter::LANES, 0);
+                    chunk.r2.resize(m + filter::LANES, 0.0);
+                    let c = filter::Candidates {
+                        entries: &chunk.candidates,
+                        x: &chunk.candidate_x,
+                        shift: &chunk.candidate_shift,
+                    };
+                    let accepted = filter::within(
+                        simd,
+                        &points[i],
+                        &c,
+                        r2max,
+                        filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
+                    );
+                    let len = first + accepted;
+                    chunk.entries.truncate(len);
+                    // The payload over whole vectors: the pairs padded with copies of the search
+                    // radius, whose values are then dropped (a scalar tail loop would cost as
+                    // much as the vector body).
+                    let padded = accepted.next_multiple_of(filter::LANES);
+                    chunk.r2[accepted..padded].fill(r2max);
+                    chunk.payload.resize(first + padded, P::default());
+                    payload(&chunk.r2[..padded], &mut chunk.payload[first..]);
+                    chunk.payload.truncate(len);
+                    *out =
+                        reduce(Listed { entries: &chunk.entries[first..], payload: &chunk.payload[first..] });
                 }
-                let first = chunk.entries.len();
-                chunk.start.push(first as u32);
-                let m = chunk.candidates.len();
-                // Room for every candidate plus one vector of lanes past the last.
-                chunk.entries.resize(first + m + filter::LANES, 0);
-                chunk.r2.resize(m + filter::LANES, 0.0);
-                let c = filter::Candidates {
-                    entries: &chunk.candidates,
-                    x: &chunk.candidate_x,
-                    shift: &chunk.candidate_shift,
-                };
-                let accepted = filter::within(
-                    simd,
-                    &points[i],
-                    &c,
-                    r2max,
-                    filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
-                );
-                let len = first + accepted;
-                chunk.entries.truncate(len);
-                // The payload over whole vectors: the pairs padded with copies of the search
-                // radius, whose values are then dropped (a scalar tail loop would cost as
-                // much as the vector body).
-                let padded = accepted.next_multiple_of(filter::LANES);
-                chunk.r2[accepted..padded].fill(r2max);
-                chunk.payload.resize(first + padded, P::default());
-                payload(&chunk.r2[..padded], &mut chunk.payload[first..]);
-                chunk.payload.truncate(len);
-            }
-            chunk.start.push(chunk.entries.len() as u32);
-            chunk.keep_headroom();
-        });
+                chunk.start.push(chunk.entries.len() as u32);
+                chunk.keep_headroom();
+            },
+        );
     }
 
     /// Lists, for every query point, its neighbours among `sources` (binned by `cells`),
@@ -340,7 +373,10 @@ mod tests {
             let mut cells = CellList::new(d, radius);
             cells.update(&pts);
             let mut nl = NeighbourList::<2, f64>::new();
-            nl.build(&cells, &pts, |r2, out| out.copy_from_slice(r2));
+            // Built with a reduction per point: the sum of j * r2 over its neighbours.
+            let mut sums = vec![0.0; pts.len()];
+            let reduce = |l: Listed<'_, f64>| l.iter().fold(0.0, |s, (j, &r2)| s + j as f64 * r2);
+            nl.build_reducing(&cells, &pts, |r2, out| out.copy_from_slice(r2), &mut sums, reduce);
             let brute = brute_force_neighbours(&d, radius, &pts, &pts);
             for i in 0..pts.len() {
                 let mut v = Vec::new();
@@ -350,6 +386,9 @@ mod tests {
                     assert!(r2 < radius * radius);
                     v.push(j);
                 });
+                let mut sum = 0.0;
+                nl.for_each(i, &pts, |j, _, r2, _| sum += j as f64 * r2);
+                assert_eq!(sums[i], sum, "the reduction sums the listed pairs in list order");
                 v.sort();
                 assert_eq!(v, brute[i], "point {i}");
                 // The same pairs as arrays, at moved positions, with a value per neighbour.

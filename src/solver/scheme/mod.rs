@@ -12,7 +12,9 @@ mod plan;
 mod walls;
 
 pub use free_surface::SurfaceFields;
-pub use passes::{build_kernel_list, ipst_chi_reference, FluidPasses, KernelList};
+pub use passes::{
+    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, FluidPasses, KernelList,
+};
 pub use walls::WallSet;
 
 use serde::{Deserialize, Serialize};

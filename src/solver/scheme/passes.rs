@@ -33,6 +33,27 @@ pub fn build_kernel_list<const D: usize>(
     nl.build(cells, &fluid.x, |r2, out| k.w_and_grad_factor_batch(r2, out));
 }
 
+/// As [`build_kernel_list`], also summing each particle's density over the fluid,
+/// `sum_b m_b W_ab`, into `rho` while its pairs are in cache (the walls' share is added by
+/// [`FluidPasses::summation_density`]).
+pub fn build_kernel_list_summing_density<const D: usize>(
+    nl: &mut KernelList<D>,
+    cells: &CellList<D>,
+    fluid: &Fluid<D>,
+    k: &Kernel,
+    rho: &mut Vec<f64>,
+) {
+    let (k, m) = (k.scaled(fluid.h), &fluid.m);
+    rho.resize(fluid.len(), 0.0);
+    nl.build_reducing(
+        cells,
+        &fluid.x,
+        |r2, out| k.w_and_grad_factor_batch(r2, out),
+        rho,
+        |pairs| pairs.iter().fold(0.0, |s, (j, &(w, _))| s + m[j] * w),
+    );
+}
+
 /// Builds the list of the neighbours of `queries` (a body of smoothing length `h`) among
 /// `sources` (binned by `cells`), with the kernel values of each pair.
 pub fn build_kernel_list_cross<const D: usize>(
@@ -154,17 +175,19 @@ impl<const D: usize> FluidPasses<D> {
         }
     }
 
-    /// Summation density, `rho_a = sum_b m_b W_ab` over the fluid and the walls.
-    pub fn summation_density(fluid: &mut Fluid<D>, nl: &KernelList<D>, walls: Option<&WallSet<D>>) {
-        let (x, m) = (&fluid.x, &fluid.m);
-        fluid.rho.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, rho)| {
-            let mut s = 0.0;
-            nl.for_each(i, x, |j, _, _, &(w, _)| s += m[j] * w);
-            if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, _, _, &(w, _)| s += ws.wall.m[j] * w);
-            }
-            *rho = s;
-        });
+    /// Summation density, `rho_a = sum_b m_b W_ab` over the fluid and the walls: the
+    /// fluid's share `fluid_sums` (summed as the list was built), then the walls'.
+    pub fn summation_density(fluid: &mut Fluid<D>, fluid_sums: &[f64], walls: Option<&WallSet<D>>) {
+        let x = &fluid.x;
+        fluid.rho.par_iter_mut().zip(fluid_sums).enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(
+            |(i, (rho, &s))| {
+                *rho = s;
+                if let Some(ws) = walls {
+                    ws.fluid_to_wall
+                        .for_each_from(i, x[i], &ws.wall.x, |j, _, _, &(w, _)| *rho += ws.wall.m[j] * w);
+                }
+            },
+        );
     }
 
     /// Pass A: the density and pressure rates (eqs. 25 and 26), then their explicit
