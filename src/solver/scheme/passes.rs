@@ -3,7 +3,7 @@
 //! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
 //! for any number of threads.
 
-use super::plan::{self, with_plan};
+use super::plan::{self, with_accelerations_plan, with_rates_plan};
 use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, SurfaceFields, WallSet};
 use crate::solver::equations::{
     artificial_viscosity, continuity, edac, free_surface, momentum, shifting, viscosity, Pair, Point,
@@ -206,8 +206,7 @@ impl<const D: usize> FluidPasses<D> {
         let terms = RateTerms::new(s);
         if continuity_on || terms.plan & plan::EDAC != 0 {
             let src = self.gather(fluid, nl, walls);
-            let rate =
-                |i: usize| with_plan!(plan::RATES; terms.plan, P => terms.sums::<P, D>(&src, i); 0 1 2 3);
+            let rate = |i: usize| with_rates_plan!(terms.plan, P => terms.sums::<P, D>(&src, i));
             match (terms.plan & plan::EDAC != 0, continuity_on) {
                 (true, true) => rates
                     .dp
@@ -275,7 +274,7 @@ impl<const D: usize> FluidPasses<D> {
         };
         let terms = AccelTerms::new(s);
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
-            let sums = with_plan!(plan::ACCELERATIONS; terms.plan, P => terms.sums::<P, D>(&src, i); 0 1 2 3 4 5 6 7 8 9 10 11);
+            let sums = with_accelerations_plan!(terms.plan, P => terms.sums::<P, D>(&src, i));
             let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
             // BQL: the gradient with the neighbour-mean pressure as reference; the mean is
             // constant over the sum, so it is applied once here (c_ref is zero without BQL).
@@ -823,7 +822,7 @@ mod tests {
         for &p in &plan::ACCELERATIONS {
             let terms = AccelTerms { plan: p, ..accel };
             for i in 0..fluid.len() {
-                let compiled = with_plan!(plan::ACCELERATIONS; p, P => terms.sums::<P, 2>(&src, i); 0 1 2 3 4 5 6 7 8 9 10 11);
+                let compiled = with_accelerations_plan!(p, P => terms.sums::<P, 2>(&src, i));
                 let runtime = terms.sums::<{ plan::RUNTIME }, 2>(&src, i);
                 assert_eq!(
                     (compiled.acc, compiled.ac, compiled.c_ref),
@@ -835,7 +834,7 @@ mod tests {
         for &p in &plan::RATES {
             let terms = RateTerms { plan: p, ..rates };
             for i in 0..fluid.len() {
-                let compiled = with_plan!(plan::RATES; p, P => terms.sums::<P, 2>(&src, i); 0 1 2 3);
+                let compiled = with_rates_plan!(p, P => terms.sums::<P, 2>(&src, i));
                 assert_eq!(compiled, terms.sums::<{ plan::RUNTIME }, 2>(&src, i), "plan {p:#b}");
             }
         }

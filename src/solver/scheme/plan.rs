@@ -94,3 +94,21 @@ macro_rules! with_plan {
     }};
 }
 pub(crate) use with_plan;
+
+/// [`with_plan!`] over [`ACCELERATIONS`] (pass B).
+macro_rules! with_accelerations_plan {
+    ($plan:expr, $p:ident => $body:expr) => {
+        $crate::solver::scheme::plan::with_plan!(
+            $crate::solver::scheme::plan::ACCELERATIONS; $plan, $p => $body; 0 1 2 3 4 5 6 7 8 9 10 11
+        )
+    };
+}
+pub(crate) use with_accelerations_plan;
+
+/// [`with_plan!`] over [`RATES`] (pass A).
+macro_rules! with_rates_plan {
+    ($plan:expr, $p:ident => $body:expr) => {
+        $crate::solver::scheme::plan::with_plan!($crate::solver::scheme::plan::RATES; $plan, $p => $body; 0 1 2 3)
+    };
+}
+pub(crate) use with_rates_plan;
