@@ -68,6 +68,13 @@ fn a_blow_up_ends_diverged_with_a_reason_and_a_non_zero_exit() {
     assert!(s["step"].as_u64().unwrap() > 0);
     assert!(s["final_time"].as_f64().unwrap() < 1.0);
     assert!(s["metrics"].as_object().unwrap().is_empty(), "a diverged run reports no metrics");
+    // The state the check stopped is the last snapshot of the ParaView series.
+    let pvd = std::fs::read_to_string(dir.path().join("fluid.pvd")).unwrap();
+    let last = pvd.lines().rfind(|l| l.contains("<DataSet")).expect("a snapshot");
+    let t: f64 = last.split("timestep=\"").nth(1).unwrap().split('"').next().unwrap().parse().unwrap();
+    assert_eq!(t, s["final_time"].as_f64().unwrap(), "{last}");
+    let file = last.split("file=\"").nth(1).unwrap().split('"').next().unwrap();
+    assert!(dir.path().join(file).exists(), "{file}");
 }
 
 #[test]

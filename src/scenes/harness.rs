@@ -169,14 +169,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             }
         }
         if t >= next_output - eps || at_end {
-            let written = scene.snapshot(&vtu_dir, snapshot_index).and_then(|files| {
-                for (body, file) in files {
-                    let pvd = out.join(format!("{body}.pvd"));
-                    series.entry(body).or_insert_with(|| Series::new(pvd)).push(t, &format!("vtu/{file}"))?;
-                }
-                Ok(())
-            });
-            if let Err(e) = written {
+            if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
                 break Outcome::Failed(io_err(&vtu_dir, e));
             }
             snapshot_index += 1;
@@ -206,7 +199,14 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         }
         let reached = match res {
             Ok(reached) => reached,
-            Err(d) => break Outcome::Diverged(d),
+            Err(d) => {
+                // The state the check stopped, as the last snapshot of the series: what blew
+                // up and where, for ParaView. Best effort: the divergence is the result.
+                if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
+                    eprintln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
+                }
+                break Outcome::Diverged(d);
+            }
         };
         // At a step boundary: checkpoint when stopped early or when it is time to.
         let due = opts.checkpoint_every.is_some_and(|s| last_checkpoint.elapsed().as_secs_f64() >= s);
@@ -256,6 +256,23 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         (_, Err(e)) => Err(RunError::Failed(e)),
         _ => Ok(s),
     }
+}
+
+/// Writes snapshot `index` of every body of `scene` and adds it to the bodies' `.pvd`
+/// series at the scene's time.
+fn snapshot(
+    scene: &dyn SceneRun,
+    out: &Path,
+    vtu_dir: &Path,
+    index: usize,
+    series: &mut BTreeMap<String, Series>,
+) -> std::io::Result<()> {
+    let t = scene.time();
+    for (body, file) in scene.snapshot(vtu_dir, index)? {
+        let pvd = out.join(format!("{body}.pvd"));
+        series.entry(body).or_insert_with(|| Series::new(pvd)).push(t, &format!("vtu/{file}"))?;
+    }
+    Ok(())
 }
 
 enum Outcome {
