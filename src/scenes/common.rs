@@ -5,7 +5,7 @@ use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
-use crate::solver::particles::{Fluid, FluidInit, Wall};
+use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity};
 use crate::solver::scheme::{
     Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName, SurfacePressure,
 };
@@ -352,4 +352,19 @@ pub fn wall_from(
         rho0,
         c0,
     )
+}
+
+/// The wall density the parameters ask for (see [`wall_params`]).
+pub fn wall_density(p: &Params) -> WallDensity {
+    WallDensity::from_name(p.str("wall_density")).expect("checked choice (wall_params)")
+}
+
+/// The parameters of a scene with walls.
+pub fn wall_params() -> Vec<Spec> {
+    vec![Spec::choice(
+        "wall_density",
+        WallDensity::NAMES,
+        "state_equation",
+        "density of the wall particles: from their extrapolated pressure by the linear state equation (Adami 2012), or the reference density (PySPH's EDAC walls)",
+    )]
 }

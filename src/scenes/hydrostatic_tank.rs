@@ -11,7 +11,8 @@
 
 use super::common::{
     check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_from, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
+    wall_params, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -45,6 +46,7 @@ fn params() -> Vec<Spec> {
     ];
     v.extend(scheme_params("none"));
     v.extend(free_surface_params());
+    v.extend(wall_params());
     v.extend(common_params(2.0));
     v
 }
@@ -73,7 +75,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let x = lattice(0.0, width, 0.0, height, dx);
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
     let wall =
-        wall_from(&box_walls(width, 1.5 * height, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?;
+        wall_from(&box_walls(width, 1.5 * height, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
+            .with_density(wall_density(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
     let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: 10.0 };

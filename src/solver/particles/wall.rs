@@ -7,6 +7,37 @@ use crate::solver::equations::wall::Ghost;
 use crate::solver::math::Vector;
 use serde::{Deserialize, Serialize};
 
+/// The density a wall particle presents to the fluid (its volume `m / rho` weighs every
+/// wall term).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum WallDensity {
+    /// Through the linear state equation from the extrapolated pressure,
+    /// `rho = rho0 + p / c0^2` (Adami et al. 2012): for a fluid whose pressure follows its
+    /// density the same way.
+    #[default]
+    StateEquation,
+    /// The reference density, as PySPH's EDAC scheme keeps its walls: with EDAC the
+    /// pressure evolves by itself and its level says nothing of the density. With the
+    /// state equation instead, the mean pressure EDAC accumulates in a closed box (0.17
+    /// rho0 c0^2 in the cavity) makes the walls lighter than the fluid, and the fluid
+    /// drifts onto them over tens of seconds (measured: `problems/cavity.toml`).
+    Reference,
+}
+
+impl WallDensity {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["state_equation", "reference"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "state_equation" => Self::StateEquation,
+            "reference" => Self::Reference,
+            _ => return None,
+        })
+    }
+}
+
 /// State of one wall body (struct of arrays).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Wall<const D: usize> {
@@ -20,11 +51,13 @@ pub struct Wall<const D: usize> {
     pub normal: Vec<Vector<D>>,
     /// Masses (rho0 dx^D).
     pub m: Vec<f64>,
-    /// Reference density: the wall density follows the extrapolated pressure through the
-    /// linear state equation, `rho = rho0 + p / c0^2` (Adami et al. 2012).
+    /// Reference density.
     pub rho0: f64,
-    /// Speed of sound of that state equation.
+    /// Speed of sound of the state equation, for [`WallDensity::StateEquation`].
     pub c0: f64,
+    /// How the wall's density follows its extrapolated pressure (set by the scheme).
+    #[serde(default)]
+    pub density: WallDensity,
     /// Extrapolated values, eqs. (46)-(52): recomputed from the fluid before every use,
     /// so not part of a checkpoint.
     #[serde(skip)]
@@ -57,7 +90,22 @@ impl<const D: usize> Wall<D> {
             return Err(format!("wall `{name}`: normal of particle {i} is not a unit vector"));
         }
         let ghost = u_wall.iter().map(|&u| Ghost { p: 0.0, u_slip: u, u_hat_slip: u, u_noslip: u }).collect();
-        Ok(Self { name: name.into(), x, u_wall, normal, m: vec![mass; n], rho0, c0, ghost })
+        Ok(Self {
+            name: name.into(),
+            x,
+            u_wall,
+            normal,
+            m: vec![mass; n],
+            rho0,
+            c0,
+            density: WallDensity::default(),
+            ghost,
+        })
+    }
+
+    /// The wall with its density model set.
+    pub fn with_density(self, density: WallDensity) -> Self {
+        Self { density, ..self }
     }
 
     /// Number of particles.
@@ -70,9 +118,32 @@ impl<const D: usize> Wall<D> {
         self.x.is_empty()
     }
 
-    /// Density of particle `i` from its extrapolated pressure.
+    /// Density of particle `i` (see [`WallDensity`]).
     #[inline(always)]
     pub fn rho(&self, i: usize) -> f64 {
-        self.rho0 + self.ghost[i].p / (self.c0 * self.c0)
+        match self.density {
+            WallDensity::StateEquation => self.rho0 + self.ghost[i].p / (self.c0 * self.c0),
+            WallDensity::Reference => self.rho0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wall_density_follows_the_pressure_or_stays_at_the_reference() {
+        let x = vec![Vector::<2>::zeros()];
+        let n = vec![Vector::<2>::new(0.0, 1.0)];
+        let mut w = Wall::new("w", x.clone(), x, n, 1e-3, 1000.0, 20.0).unwrap();
+        w.ghost[0].p = 800.0;
+        assert_eq!(w.rho(0), 1002.0, "rho0 + p / c0^2 by default");
+        let w = w.with_density(WallDensity::Reference);
+        assert_eq!(w.rho(0), 1000.0);
+        for name in WallDensity::NAMES {
+            assert!(WallDensity::from_name(name).is_some());
+        }
+        assert_eq!(WallDensity::from_name("heavy"), None);
     }
 }
