@@ -55,7 +55,8 @@ pub struct Wall<const D: usize> {
     pub rho0: f64,
     /// Speed of sound of the state equation, for [`WallDensity::StateEquation`].
     pub c0: f64,
-    /// How the wall's density follows its extrapolated pressure (set by the scheme).
+    /// How the wall's density follows its extrapolated pressure (a scene sets it from its
+    /// `wall_density` parameter).
     #[serde(default)]
     pub density: WallDensity,
     /// Extrapolated values, eqs. (46)-(52): recomputed from the fluid before every use,
