@@ -98,6 +98,7 @@ static STUBS: &[SceneEntry] = &[
         params: cavity_params,
         build: unbuildable,
         metrics: &["ghia_u_rms", "ghia_u_max", "ghia_v_rms", "ghia_v_max", "kinetic_energy_change"],
+        outputs: 0,
     },
     SceneEntry {
         name: "hydrostatic_tank",
@@ -106,6 +107,7 @@ static STUBS: &[SceneEntry] = &[
         params: tank_params,
         build: unbuildable,
         metrics: &["pressure_rel_error", "max_speed"],
+        outputs: 0,
     },
     SceneEntry {
         name: "dam_break",
@@ -114,6 +116,7 @@ static STUBS: &[SceneEntry] = &[
         params: dam_break_params,
         build: unbuildable,
         metrics: &["toe_rms", "particles_lost", "max_penetration"],
+        outputs: 0,
     },
     SceneEntry {
         name: "free_surface_demo",
@@ -122,6 +125,7 @@ static STUBS: &[SceneEntry] = &[
         params: free_surface_params,
         build: unbuildable,
         metrics: &["surface_particles", "interior_surface_particles"],
+        outputs: 0,
     },
 ];
 

@@ -11,9 +11,18 @@ use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-/// The solver fingerprint in every key: crate version and scheme version.
+/// The solver fingerprint: crate version and scheme version.
 pub fn fingerprint() -> String {
     format!("{}+scheme{}", env!("CARGO_PKG_VERSION"), SCHEME_VERSION)
+}
+
+/// The fingerprint in the keys of `scene`'s cases: the solver's, and the version of what the
+/// scene reports when above 0 (so that the keys of scenes still at 0 stay as they were).
+pub fn fingerprint_of(scene: &str) -> String {
+    match crate::scenes::find(scene) {
+        Ok(e) if e.outputs > 0 => format!("{}+{}-outputs{}", fingerprint(), e.name, e.outputs),
+        _ => fingerprint(),
+    }
 }
 
 /// The inputs of a case, written to `case.json` in its folder.
@@ -37,7 +46,7 @@ impl CaseRecord {
     /// The record of `case` of `problem` for this binary.
     pub fn new(problem: &str, case: &Case) -> Self {
         let params = case.params.to_json();
-        let solver = fingerprint();
+        let solver = fingerprint_of(&case.scene);
         let canonical = serde_json::json!({
             "scene": case.scene,
             "params": params,
@@ -214,5 +223,13 @@ mod tests {
         assert_ne!(a.key, c.key);
         assert_eq!(c.changes_from(&a), "nx 16 -> 20");
         assert!(a.folder().starts_with("a-") && a.folder().len() == 12);
+    }
+
+    #[test]
+    fn a_scene_that_reports_more_has_new_keys_the_others_keep_theirs() {
+        assert_eq!(fingerprint_of("cavity"), fingerprint());
+        let tg = crate::scenes::find("taylor_green").unwrap();
+        assert!(tg.outputs > 0 && fingerprint_of("taylor_green") != fingerprint());
+        assert_eq!(CaseRecord::new("p", &case(16)).solver, fingerprint_of("taylor_green"));
     }
 }

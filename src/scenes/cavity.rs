@@ -40,6 +40,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     metrics: &["ghia_u_rms", "ghia_u_max", "ghia_v_rms", "ghia_v_max", "kinetic_energy_change"],
+    outputs: 0,
 };
 
 fn params() -> Vec<Spec> {

@@ -43,6 +43,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     metrics: &["toe_rms", "particles_lost", "max_penetration"],
+    outputs: 0,
 };
 
 fn params() -> Vec<Spec> {

@@ -31,6 +31,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     metrics: &["surface_particles", "interior_surface_particles", "outer_layer_missed"],
+    outputs: 0,
 };
 
 /// Whether a particle belongs to the shape's outer layer (the particles a surface detection

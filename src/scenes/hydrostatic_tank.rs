@@ -35,6 +35,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     metrics: &["pressure_rel_error", "max_speed", "particles_outside"],
+    outputs: 0,
 };
 
 fn params() -> Vec<Spec> {

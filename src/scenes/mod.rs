@@ -67,6 +67,10 @@ pub struct SceneEntry {
     pub build: fn(&Params) -> Result<Box<dyn SceneRun>, String>,
     /// Names of the metrics written to `summary.json`.
     pub metrics: &'static [&'static str],
+    /// Version of what the scene reports (metrics, time-series columns): raised when one is
+    /// added, so that cached results without it are stale and rerun (it joins the cache
+    /// key; 0 adds nothing to it).
+    pub outputs: u32,
 }
 
 /// Every scene.
