@@ -136,6 +136,7 @@ fn a_completed_run_writes_the_contracted_outputs() {
     for m in [
         "l1_velocity_final",
         "l1_velocity_max",
+        "l1_velocity_mean",
         "umax_decay_rel_error",
         "p_l1_final",
         "kinetic_energy_rel_error",
@@ -148,6 +149,23 @@ fn a_completed_run_writes_the_contracted_outputs() {
     let ts = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
     assert!(ts.lines().next().unwrap().starts_with("t,u_max,u_max_exact,l1_velocity"));
     assert!(ts.lines().count() > 10);
+    // The mean L1 error is the trapezoidal time average of the series' L1 column.
+    let rows: Vec<(f64, f64)> = ts
+        .lines()
+        .skip(1)
+        .map(|l| {
+            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
+            (v[0], v[3])
+        })
+        .collect();
+    let integral: f64 = rows.windows(2).map(|w| 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1)).sum();
+    let (t_end, mean) = (rows.last().unwrap().0, s["metrics"]["l1_velocity_mean"].as_f64().unwrap());
+    assert!((t_end - 0.05).abs() < 1e-12, "the series ends at tf");
+    assert!(
+        (mean - integral / t_end).abs() <= 1e-12 * mean.abs().max(1e-300),
+        "{mean} vs {}",
+        integral / t_end
+    );
     let pvd = std::fs::read_to_string(dir.path().join("fluid.pvd")).unwrap();
     let n = pvd.matches("<DataSet").count();
     assert_eq!(n, 11, "snapshots at 0, tf/10, ..., tf");
