@@ -139,3 +139,27 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
     }
     assert!(!b.path().join("checkpoint.json").exists(), "a finished run leaves no checkpoint");
 }
+
+/// `ipst_interval = 5` (the authors' code's default; the paper shifts every step): IPST moves
+/// the particles on every fifth step only, and there is no homogenisation acceleration on
+/// the others.
+#[test]
+fn ipst_runs_on_every_interval_th_step_only() {
+    // A perturbed lattice and a tolerance it never meets: every IPST step makes all its moves.
+    let sets = ["nx=16", "perturb=0.1", "scheme=ctvf", "pst=ipst", "ipst_tol=1e-12", "ipst_max_iter=3"];
+    for interval in [1u64, 5] {
+        let i = format!("ipst_interval={interval}");
+        let params = taylor_green::params_from(&[&sets[..], &[i.as_str()]].concat()).unwrap();
+        let mut sim = taylor_green::simulation(&params).unwrap();
+        assert_eq!(sim.last_ipst_iterations(), 3, "the first step shifts");
+        for _ in 0..12 {
+            sim.step(f64::INFINITY).unwrap();
+            // The accelerations just evaluated are for the next step, whose index is the
+            // number of steps made.
+            let due = sim.steps().is_multiple_of(interval);
+            let shifted = sim.state.rates.a_c.iter().any(|a| a.norm() > 0.0);
+            assert_eq!(sim.last_ipst_iterations(), if due { 3 } else { 0 }, "interval {interval}");
+            assert_eq!(shifted, due, "interval {interval}, step {}", sim.steps());
+        }
+    }
+}

@@ -47,6 +47,7 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
             corrections: Corrections::ALL,
             ipst_tol: 0.02,
             ipst_max_iter: 10,
+            ipst_interval: 1,
             gravity: [0.0; 3],
             internal_flow: true,
             free_surface: None,

@@ -48,6 +48,12 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
         ),
         Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
+        Spec::int(
+            "ipst_interval",
+            1,
+            1,
+            "IPST on every this many steps, no homogenisation in between (the paper: 1; the authors' code: 5)",
+        ),
     ]
 }
 
@@ -166,6 +172,7 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
         corrections,
         ipst_tol: p.float("ipst_tol"),
         ipst_max_iter: p.int("ipst_max_iter") as usize,
+        ipst_interval: p.int("ipst_interval") as usize,
         gravity: c.gravity,
         internal_flow: c.internal_flow,
         free_surface: c.free_surface.then(|| {

@@ -189,7 +189,7 @@ impl<const D: usize> Simulation<D> {
             sim.extrapolate_walls();
         }
         let dt = sim.nominal_dt();
-        sim.evaluate_accelerations(dt);
+        sim.evaluate_accelerations(dt, 0);
         Ok(sim)
     }
 
@@ -270,7 +270,8 @@ impl<const D: usize> Simulation<D> {
         )
     }
 
-    fn evaluate_accelerations(&mut self, dt_nominal: f64) {
+    /// The accelerations of the state, for step `next_step` (0 the first).
+    fn evaluate_accelerations(&mut self, dt_nominal: f64, next_step: u64) {
         let clock = std::time::Instant::now();
         let (st, walls) = (&mut self.state, self.walls.as_ref());
         if let (Some(fs), Some(free)) = (self.surface.as_mut(), st.scheme.free_surface) {
@@ -297,6 +298,7 @@ impl<const D: usize> Simulation<D> {
             &st.scheme,
             &mut st.rates,
             dt_nominal,
+            next_step,
         );
         lap(clock, &mut self.times.ipst);
     }
@@ -332,7 +334,8 @@ impl<const D: usize> Simulation<D> {
         // The walls follow the updated fluid pressure before the accelerations use it.
         self.extrapolate_walls();
         lap(clock, &mut self.times.pressure);
-        self.evaluate_accelerations(dt_nominal);
+        // For the next step (its kick applies the homogenisation acceleration).
+        self.evaluate_accelerations(dt_nominal, self.state.steps + 1);
         let clock = std::time::Instant::now();
         let st = &mut self.state;
         integrator::kick(&mut st.fluid.u, &st.rates.du, dt);

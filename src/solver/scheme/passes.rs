@@ -305,7 +305,9 @@ impl<const D: usize> FluidPasses<D> {
 
     /// IPST (eqs. 37-41): move copies of the particles by `U_max dt sum V_b n_ab W_ab` until
     /// `|max chi - chi_ref| <= tol chi_ref` (eq. 39, chi of eq. 40) or `max_iter` moves,
-    /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41). The particles themselves are not
+    /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41), on steps whose index `step` is a
+    /// multiple of the scheme's interval (every step by default, as the paper says), with
+    /// `(du/dt)_c = 0` on the others. The particles themselves are not
     /// moved: the kick of the next step applies the displacement through u~. Walls are
     /// fixed neighbours.
     ///
@@ -325,10 +327,17 @@ impl<const D: usize> FluidPasses<D> {
         s: &FluidScheme,
         rates: &mut FluidRates<D>,
         dt: f64,
+        step: u64,
     ) -> usize {
-        let Some(Shifting::Ipst { u_max, tol, max_iter, chi_ref }) = s.transport.map(|t| t.shifting) else {
+        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref }) =
+            s.transport.map(|t| t.shifting)
+        else {
             return 0;
         };
+        if !step.is_multiple_of(interval as u64) {
+            rates.a_c.par_iter_mut().with_min_len(MIN_LEN).for_each(|ac| *ac = Vector::zeros());
+            return 0;
+        }
         let k = k.scaled(fluid.h);
         let n = fluid.len();
         self.x_shift.clear();
@@ -738,6 +747,7 @@ mod tests {
             corrections: Corrections::ALL,
             ipst_tol: 0.02,
             ipst_max_iter: 10,
+            ipst_interval: 1,
             gravity: [0.0; 3],
             internal_flow: true,
             free_surface: None,
