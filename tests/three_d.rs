@@ -6,7 +6,9 @@ use sphrepro::solver::kernel::{Kernel, KernelKind};
 use sphrepro::solver::math::Vector;
 use sphrepro::solver::nnps::Domain;
 use sphrepro::solver::particles::{Fluid, FluidInit};
-use sphrepro::solver::scheme::{Corrections, DensityModel, FluidSettings, Pst, SchemeName};
+use sphrepro::solver::scheme::{
+    Corrections, DensityModel, FluidSettings, PressureReference, Pst, SchemeName,
+};
 use sphrepro::solver::simulation::{Simulation, TimeSettings};
 
 #[test]
@@ -50,6 +52,8 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
             ipst_interval: 1,
             gravity: [0.0; 3],
             internal_flow: true,
+            walls: false,
+            pressure_reference: PressureReference::Auto,
             free_surface: None,
         };
         let s = scheme.fluid_scheme(&settings);

@@ -1,5 +1,6 @@
 //! Walls (Adami et al. 2012, CTVF sec. 3.6): fluid at rest in a tank stays inside with the
-//! hydrostatic pressure; the lid-driven cavity at Re = 100 approaches Ghia's profiles.
+//! hydrostatic pressure; the lid-driven cavity at Re = 100 approaches Ghia's profiles, and
+//! at Re = 1000 stays free of voids with the pressure gradient of eq. (27).
 //! Bounds are the quick-preset values measured on this code (stated), plus 30 %.
 
 use sphrepro::scenes::harness::{self, RunOptions};
@@ -27,9 +28,23 @@ fn a_tank_at_rest_keeps_its_fluid_and_its_hydrostatic_pressure() {
 #[test]
 fn the_cavity_at_re_100_approaches_ghia() {
     let m = run(&cavity::ENTRY, &["nx=30", "re=100", "tf=5.0", "pst=sun"]);
-    // measured: ghia_u_rms 2.28e-2, ghia_v_rms 1.51e-2 (units of the lid speed)
-    assert!(m["ghia_u_rms"] < 0.030, "{m:?}");
-    assert!(m["ghia_v_rms"] < 0.020, "{m:?}");
+    // measured: ghia_u_rms 2.40e-2, ghia_v_rms 1.28e-2 (units of the lid speed; with BQL,
+    // the default before eq. (27) was followed here, 2.28e-2 and 1.51e-2)
+    assert!(m["ghia_u_rms"] < 0.031, "{m:?}");
+    assert!(m["ghia_v_rms"] < 0.017, "{m:?}");
+}
+
+/// Eq. (27) as printed (the cavity's default, `pressure_reference = auto` within walls)
+/// keeps the fluid under the lid free of voids at Re = 1000; with the neighbours' mean
+/// pressure subtracted (BQL, the Taylor-Green default) voids open there (and at 50x50 the
+/// fluid then leaves the cavity at t = 3.2 s). Measured (nx = 30, t = 4 s): the smallest
+/// density over the run is 0.857 rho0 without BQL, 0.420 with it.
+#[test]
+fn the_cavity_at_re_1000_stays_free_of_voids_with_eq_27() {
+    let m = run(&cavity::ENTRY, &["nx=30", "re=1000", "tf=4.0"]);
+    assert!(m["min_density"] > 0.8, "{m:?}");
+    let bql = run(&cavity::ENTRY, &["nx=30", "re=1000", "tf=4.0", "pressure_reference=local_mean"]);
+    assert!(bql["min_density"] < 0.6, "{bql:?}");
 }
 
 #[test]

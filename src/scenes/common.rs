@@ -7,7 +7,8 @@ use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
 use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity};
 use crate::solver::scheme::{
-    Corrections, DensityModel, FluidScheme, FluidSettings, Pst, SchemeName, SurfacePressure,
+    Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
+    SurfacePressure,
 };
 use crate::solver::simulation::Simulation;
 use std::path::Path;
@@ -39,6 +40,12 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             SWITCH,
             "auto",
             "the -u div(u~ - u) term of eq. (19); auto follows `corrections`",
+        ),
+        Spec::choice(
+            "pressure_reference",
+            PressureReference::NAMES,
+            "auto",
+            "pressure subtracted in the pressure gradient: auto (the scheme's: the neighbour mean (BQL) for edac, and for ctvf in a periodic box), local_mean (BQL) or none (eq. 27 as printed)",
         ),
         Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
         Spec::float(
@@ -95,14 +102,16 @@ pub struct FluidConstants {
     pub gravity: [f64; 3],
     /// No free surface (the pressure level is arbitrary).
     pub internal_flow: bool,
+    /// Wall bodies bound the fluid.
+    pub walls: bool,
     /// A free surface to detect and keep the shifting tangential to.
     pub free_surface: bool,
 }
 
 impl FluidConstants {
     /// An internal flow at Reynolds number `re` on velocity `u` and length `l`: viscosity
-    /// `u l / re`, summation density, no gravity, no artificial viscosity, and an arbitrary
-    /// pressure level (the BQL reference of internal flows).
+    /// `u l / re`, summation density, no gravity, no artificial viscosity, an arbitrary
+    /// pressure level and no walls (see [`with_walls`](Self::with_walls)).
     pub fn internal_flow(rho0: f64, c0: f64, u: f64, l: f64, re: f64, dx: f64) -> Self {
         Self {
             rho0,
@@ -114,13 +123,20 @@ impl FluidConstants {
             density: DensityModel::Summation,
             gravity: [0.0; 3],
             internal_flow: true,
+            walls: false,
             free_surface: false,
         }
     }
 
+    /// The same fluid bounded by walls.
+    pub fn with_walls(self) -> Self {
+        Self { walls: true, ..self }
+    }
+
     /// Water of depth `height` under gravity `g` with a free surface: reference velocity
     /// `sqrt(2 g H)`, speed of sound ten times it, the continuity equation (25) for the
-    /// density, artificial viscosity `alpha` (eq. 28) and no physical viscosity.
+    /// density, artificial viscosity `alpha` (eq. 28) and no physical viscosity, in a tank
+    /// (walls).
     pub fn under_gravity(rho0: f64, g: f64, height: f64, dx: f64, alpha: f64) -> Self {
         Self {
             rho0,
@@ -132,6 +148,7 @@ impl FluidConstants {
             density: DensityModel::Continuity,
             gravity: [0.0, -g, 0.0],
             internal_flow: false,
+            walls: true,
             free_surface: true,
         }
     }
@@ -175,6 +192,9 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
         ipst_interval: p.int("ipst_interval") as usize,
         gravity: c.gravity,
         internal_flow: c.internal_flow,
+        walls: c.walls,
+        pressure_reference: PressureReference::from_name(p.str("pressure_reference"))
+            .expect("checked choice"),
         free_surface: c.free_surface.then(|| {
             SurfacePressure::from_name(p.str("surface_pressure"))
                 .expect("checked choice (free_surface_params)")

@@ -78,6 +78,52 @@ impl Pst {
     }
 }
 
+/// The reference pressure subtracted from `p_a` and `p_b` in the pressure gradient.
+///
+/// Eq. (27) subtracts none. With none, a uniform pressure offset pushes particles apart
+/// (positive) or together (negative, the tensile instability); subtracting the mean
+/// pressure of the neighbours (Basa, Quinlan & Lastiwka 2009, BQL) makes the force depend
+/// on pressure differences only. Measured (2026-11-22): the Taylor-Green vortex needs BQL
+/// (50x50, t = 2: time-averaged L1 3-9x larger without it, the pressure level drifting
+/// freely in the periodic box), while the lid-driven cavity needs eq. (27) as printed (with
+/// BQL voids open under the lid and, at Re = 1000 and 50x50, the fluid leaves the cavity at
+/// t = 3.2 s; without, the walls' pressure keeps the level positive and the voids filled).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PressureReference {
+    /// The scheme's own: BQL for `edac` (as PySPH's EDACScheme) and for `ctvf` on internal
+    /// flows without walls (periodic), none for `tvf` and otherwise.
+    Auto,
+    /// The neighbours' mean pressure (BQL).
+    LocalMean,
+    /// None: eq. (27) as printed.
+    None,
+}
+
+impl PressureReference {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["auto", "local_mean", "none"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "auto" => Self::Auto,
+            "local_mean" => Self::LocalMean,
+            "none" => Self::None,
+            _ => return None,
+        })
+    }
+
+    /// Whether BQL is on, given the scheme's own choice for `Auto`.
+    pub fn bql(self, scheme_default: bool) -> bool {
+        match self {
+            Self::Auto => scheme_default,
+            Self::LocalMean => true,
+            Self::None => false,
+        }
+    }
+}
+
 /// What the pressure of the free-surface particles (sec. 3.4) does. The paper's text
 /// evolves every particle's pressure by eq. (26); the authors' public PySPH code can also
 /// zero p and dp/dt of the surface particles. In the dam break at dx = 0.02 (measured
@@ -299,9 +345,12 @@ pub struct FluidSettings {
     pub ipst_interval: usize,
     /// Gravity.
     pub gravity: [f64; 3],
-    /// An internal flow (no free surface): the pressure level is arbitrary, so the
-    /// pressure gradient uses the local mean-pressure correction (BQL).
+    /// An internal flow (no free surface): the pressure level is arbitrary.
     pub internal_flow: bool,
+    /// Wall bodies bound the fluid.
+    pub walls: bool,
+    /// The reference pressure of the pressure gradient.
+    pub pressure_reference: PressureReference,
     /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
     pub free_surface: Option<SurfacePressure>,
 }
@@ -327,7 +376,7 @@ impl SchemeName {
                 name: self,
                 density: DensityModel::Summation,
                 pressure: edac,
-                pressure_gradient: PressureGradient::Adami { bql: true },
+                pressure_gradient: PressureGradient::Adami { bql: s.pressure_reference.bql(true) },
                 viscosity: s.nu,
                 artificial_viscosity,
                 transport: Some(background(2.0)),
@@ -338,7 +387,7 @@ impl SchemeName {
                 name: self,
                 density: DensityModel::Summation,
                 pressure: PressureModel::StateEquation { c0: s.c0, rho0: s.rho0 },
-                pressure_gradient: PressureGradient::Adami { bql: false },
+                pressure_gradient: PressureGradient::Adami { bql: s.pressure_reference.bql(false) },
                 viscosity: s.nu,
                 artificial_viscosity,
                 transport: Some(background(1.0)),
@@ -361,7 +410,9 @@ impl SchemeName {
                     name: self,
                     density: s.density,
                     pressure: edac,
-                    pressure_gradient: PressureGradient::Symmetric { bql: s.internal_flow },
+                    pressure_gradient: PressureGradient::Symmetric {
+                        bql: s.pressure_reference.bql(s.internal_flow && !s.walls),
+                    },
                     viscosity: s.nu,
                     artificial_viscosity,
                     transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
@@ -450,5 +501,69 @@ impl fmt::Display for FluidScheme {
             )?;
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A viscous internal flow in a periodic box (Taylor-Green-like settings).
+    pub(crate) fn internal_flow_settings() -> FluidSettings {
+        FluidSettings {
+            rho0: 1.0,
+            c0: 10.0,
+            u_ref: 1.0,
+            h: 0.02,
+            w_dx: 1.0,
+            nu: Some(0.01),
+            alpha: None,
+            edac_alpha: 0.5,
+            density: DensityModel::Summation,
+            pst: Pst::Sun,
+            corrections: Corrections::ALL,
+            ipst_tol: 0.02,
+            ipst_max_iter: 10,
+            ipst_interval: 1,
+            gravity: [0.0; 3],
+            internal_flow: true,
+            walls: false,
+            pressure_reference: PressureReference::Auto,
+            free_surface: None,
+        }
+    }
+
+    fn bql(name: SchemeName, s: &FluidSettings) -> bool {
+        match name.fluid_scheme(s).pressure_gradient {
+            PressureGradient::Symmetric { bql } | PressureGradient::Adami { bql } => bql,
+        }
+    }
+
+    /// `auto` is each scheme's own reference: BQL for edac everywhere and for ctvf in a
+    /// periodic box, none for tvf and for ctvf within walls or with a free surface; the
+    /// explicit choices override it for every scheme.
+    #[test]
+    fn pressure_reference_per_scheme_and_flow() {
+        let periodic = internal_flow_settings();
+        let walled = FluidSettings { walls: true, ..periodic };
+        let free_surface = FluidSettings { internal_flow: false, walls: true, ..periodic };
+        use SchemeName::{Ctvf, Edac, Tvf};
+        for (name, flow, expected) in [
+            (Edac, periodic, true),
+            (Edac, walled, true),
+            (Tvf, periodic, false),
+            (Ctvf, periodic, true),
+            (Ctvf, walled, false),
+            (Ctvf, free_surface, false),
+        ] {
+            assert_eq!(bql(name, &flow), expected, "{name:?} {flow:?}");
+            for (r, on) in [(PressureReference::LocalMean, true), (PressureReference::None, false)] {
+                assert_eq!(bql(name, &FluidSettings { pressure_reference: r, ..flow }), on, "{name:?} {r:?}");
+            }
+        }
+        for (k, name) in PressureReference::NAMES.iter().enumerate() {
+            let r = PressureReference::from_name(name).unwrap();
+            assert_eq!(serde_json::to_value(r).unwrap(), PressureReference::NAMES[k]);
+        }
     }
 }

@@ -733,25 +733,9 @@ mod tests {
     /// (artificial viscosity) has loops of its own: none falls back to run-time checks.
     #[test]
     fn named_schemes_run_compiled_plans() {
-        let internal = FluidSettings {
-            rho0: 1.0,
-            c0: 10.0,
-            u_ref: 1.0,
-            h: 0.02,
-            w_dx: 1.0,
-            nu: Some(0.01),
-            alpha: None,
-            edac_alpha: 0.5,
-            density: DensityModel::Summation,
-            pst: Pst::Sun,
-            corrections: Corrections::ALL,
-            ipst_tol: 0.02,
-            ipst_max_iter: 10,
-            ipst_interval: 1,
-            gravity: [0.0; 3],
-            internal_flow: true,
-            free_surface: None,
-        };
+        let internal = super::super::tests::internal_flow_settings();
+        // The cavity: eq. (27) without BQL for ctvf under `Auto`.
+        let walled = FluidSettings { walls: true, ..internal };
         let free_surface = FluidSettings {
             nu: None,
             alpha: Some(0.05),
@@ -765,6 +749,7 @@ mod tests {
             for corrections in [Corrections::ALL, Corrections::NONE] {
                 for (flow, names) in [
                     (internal, &[SchemeName::Edac, SchemeName::Tvf, SchemeName::Ctvf][..]),
+                    (walled, &[SchemeName::Edac, SchemeName::Tvf, SchemeName::Ctvf][..]),
                     (free_surface, &[SchemeName::Ctvf][..]),
                 ] {
                     for name in names {

@@ -34,9 +34,9 @@ pub const RUNTIME: u32 = 1 << 31;
 
 /// The plans of pass B that the named schemes take on the paper's benchmarks (tested):
 /// `edac` and `tvf`, then `ctvf` with Sun's shifting, IPST or none, with and without the
-/// momentum correction, on internal flows (viscous, BQL) and on free surfaces (artificial
-/// viscosity).
-pub const ACCELERATIONS: [u32; 12] = [
+/// momentum correction, on periodic internal flows (viscous, BQL), within walls (viscous)
+/// and on free surfaces (artificial viscosity).
+pub const ACCELERATIONS: [u32; 17] = [
     ADAMI | BQL | VISCOSITY | TRANSPORT | BACKGROUND_PRESSURE,
     ADAMI | VISCOSITY | TRANSPORT | BACKGROUND_PRESSURE,
     BQL | VISCOSITY | TRANSPORT | MOMENTUM_CORR | SUN2019,
@@ -44,6 +44,11 @@ pub const ACCELERATIONS: [u32; 12] = [
     BQL | VISCOSITY | TRANSPORT | MOMENTUM_CORR,
     BQL | VISCOSITY | TRANSPORT,
     BQL | VISCOSITY,
+    VISCOSITY | TRANSPORT | MOMENTUM_CORR | SUN2019,
+    VISCOSITY | TRANSPORT | SUN2019,
+    VISCOSITY | TRANSPORT | MOMENTUM_CORR,
+    VISCOSITY | TRANSPORT,
+    VISCOSITY,
     ARTIFICIAL_VISCOSITY | TRANSPORT | MOMENTUM_CORR | SUN2019,
     ARTIFICIAL_VISCOSITY | TRANSPORT | SUN2019,
     ARTIFICIAL_VISCOSITY | TRANSPORT | MOMENTUM_CORR,
@@ -99,7 +104,7 @@ pub(crate) use with_plan;
 macro_rules! with_accelerations_plan {
     ($plan:expr, $p:ident => $body:expr) => {
         $crate::solver::scheme::plan::with_plan!(
-            $crate::solver::scheme::plan::ACCELERATIONS; $plan, $p => $body; 0 1 2 3 4 5 6 7 8 9 10 11
+            $crate::solver::scheme::plan::ACCELERATIONS; $plan, $p => $body; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16
         )
     };
 }
