@@ -80,14 +80,16 @@ impl Pst {
 
 /// The reference pressure subtracted from `p_a` and `p_b` in the pressure gradient.
 ///
-/// Eq. (27) subtracts none. With none, a uniform pressure offset pushes particles apart
-/// (positive) or together (negative, the tensile instability); subtracting the mean
-/// pressure of the neighbours (Basa, Quinlan & Lastiwka 2009, BQL) makes the force depend
-/// on pressure differences only. Measured (2026-11-22): the Taylor-Green vortex needs BQL
-/// (50x50, t = 2: time-averaged L1 3-9x larger without it, the pressure level drifting
-/// freely in the periodic box), while the lid-driven cavity needs eq. (27) as printed (with
-/// BQL voids open under the lid and, at Re = 1000 and 50x50, the fluid leaves the cavity at
-/// t = 3.2 s; without, the walls' pressure keeps the level positive and the voids filled).
+/// Eq. (27) subtracts none, so a uniform pressure level P adds P times the zeroth-order
+/// error of the SPH gradient of a disordered particle set to the momentum equation (P > 0
+/// pushes particles into voids, P < 0 pulls them together). Subtracting the mean pressure
+/// of the neighbours (Basa, Quinlan & Lastiwka 2009, BQL) leaves the force to pressure
+/// differences. Measured (2026-11-22, 50x50, problems `taylor_green_pressure_reference` and
+/// `cavity_pressure_reference`): in the Taylor-Green vortex EDAC's pressure level rises to
+/// 3 rho U^2 within 0.2 s, and under eq. (27) the time-averaged L1 error is 3-9x that with
+/// BQL; in the lid-driven cavity the level stays near 0.5 rho U^2 under eq. (27), which
+/// keeps the fluid under the lid free of voids, while with BQL voids open there and at
+/// Re = 1000 the fluid leaves the cavity (t = 3.2 s).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PressureReference {
