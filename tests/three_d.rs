@@ -6,9 +6,7 @@ use sphrepro::solver::kernel::{Kernel, KernelKind};
 use sphrepro::solver::math::Vector;
 use sphrepro::solver::nnps::Domain;
 use sphrepro::solver::particles::{Fluid, FluidInit};
-use sphrepro::solver::scheme::{
-    Corrections, DensityModel, FluidSettings, PressureReference, Pst, SchemeName,
-};
+use sphrepro::solver::scheme::{FluidSettings, Pst, SchemeName};
 use sphrepro::solver::simulation::{Simulation, TimeSettings};
 
 #[test]
@@ -35,27 +33,8 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
     for (scheme, pst) in
         [(SchemeName::Edac, Pst::None), (SchemeName::Ctvf, Pst::Sun), (SchemeName::Ctvf, Pst::Ipst)]
     {
-        let settings = FluidSettings {
-            rho0: 1.0,
-            c0: 10.0,
-            u_ref: 1.0,
-            h: dx,
-            w_dx: kernel.w(dx, dx),
-            nu: Some(0.01),
-            alpha: None,
-            edac_alpha: 0.5,
-            density: DensityModel::Summation,
-            pst,
-            corrections: Corrections::ALL,
-            ipst_tol: 0.02,
-            ipst_max_iter: 10,
-            ipst_interval: 1,
-            gravity: [0.0; 3],
-            internal_flow: true,
-            walls: false,
-            pressure_reference: PressureReference::Auto,
-            free_surface: None,
-        };
+        let settings =
+            FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
         let s = scheme.fluid_scheme(&settings);
         let fluid = Fluid::new("fluid", dx, init.clone(), s.transport.is_some()).unwrap();
         let time = TimeSettings { cfl: 0.25, c0: 10.0, u_ref: 1.0, blowup_factor: 10.0 };

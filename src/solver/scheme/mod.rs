@@ -357,6 +357,37 @@ pub struct FluidSettings {
     pub free_surface: Option<SurfacePressure>,
 }
 
+impl FluidSettings {
+    /// A viscous internal flow in a periodic box (no walls, no free surface, no gravity)
+    /// with the paper's defaults: summation density, Sun's shifting, every correction,
+    /// alpha_edac = 0.5, IPST tolerance 0.02 with at most 10 moves on every step, and the
+    /// scheme's own pressure reference. `w_dx` is W(dx) for Sun's shifting, `nu` the
+    /// kinematic viscosity.
+    pub fn internal_flow(rho0: f64, c0: f64, u_ref: f64, h: f64, w_dx: f64, nu: f64) -> Self {
+        Self {
+            rho0,
+            c0,
+            u_ref,
+            h,
+            w_dx,
+            nu: Some(nu),
+            alpha: None,
+            edac_alpha: 0.5,
+            density: DensityModel::Summation,
+            pst: Pst::Sun,
+            corrections: Corrections::ALL,
+            ipst_tol: 0.02,
+            ipst_max_iter: 10,
+            ipst_interval: 1,
+            gravity: [0.0; 3],
+            internal_flow: true,
+            walls: false,
+            pressure_reference: PressureReference::Auto,
+            free_surface: None,
+        }
+    }
+}
+
 impl SchemeName {
     /// The composition this scheme name stands for.
     pub fn fluid_scheme(self, s: &FluidSettings) -> FluidScheme {
@@ -512,27 +543,7 @@ pub(crate) mod tests {
 
     /// A viscous internal flow in a periodic box (Taylor-Green-like settings).
     pub(crate) fn internal_flow_settings() -> FluidSettings {
-        FluidSettings {
-            rho0: 1.0,
-            c0: 10.0,
-            u_ref: 1.0,
-            h: 0.02,
-            w_dx: 1.0,
-            nu: Some(0.01),
-            alpha: None,
-            edac_alpha: 0.5,
-            density: DensityModel::Summation,
-            pst: Pst::Sun,
-            corrections: Corrections::ALL,
-            ipst_tol: 0.02,
-            ipst_max_iter: 10,
-            ipst_interval: 1,
-            gravity: [0.0; 3],
-            internal_flow: true,
-            walls: false,
-            pressure_reference: PressureReference::Auto,
-            free_surface: None,
-        }
+        FluidSettings::internal_flow(1.0, 10.0, 1.0, 0.02, 1.0, 0.01)
     }
 
     fn bql(name: SchemeName, s: &FluidSettings) -> bool {
