@@ -97,7 +97,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
-    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx).with_walls();
+    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme(p, &constants);
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;

@@ -7,7 +7,7 @@ use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
 use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity};
 use crate::solver::scheme::{
-    Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
+    paper, Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
     SurfacePressure,
 };
 use crate::solver::simulation::Simulation;
@@ -47,17 +47,17 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             "auto",
             "pressure subtracted in the pressure gradient: auto (the scheme's: the neighbour mean (BQL) for edac, and for ctvf in a periodic box), local_mean (BQL) or none (eq. 27 as printed)",
         ),
-        Spec::float("edac_alpha", 0.5, Bound::Positive, "alpha of nu_edac, eq. (24)"),
+        Spec::float("edac_alpha", paper::EDAC_ALPHA, Bound::Positive, "alpha of nu_edac, eq. (24)"),
         Spec::float(
             "ipst_tol",
-            0.02,
+            paper::IPST_TOL,
             Bound::Positive,
             "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
         ),
-        Spec::int("ipst_max_iter", 10, 1, "IPST iterations per step at most"),
+        Spec::int("ipst_max_iter", paper::IPST_MAX_ITER as i64, 1, "IPST iterations per step at most"),
         Spec::int(
             "ipst_interval",
-            1,
+            paper::IPST_INTERVAL as i64,
             1,
             "IPST on every this many steps, no homogenisation in between (the paper: 1; the authors' code: 5)",
         ),
@@ -100,10 +100,6 @@ pub struct FluidConstants {
     pub density: DensityModel,
     /// Gravity.
     pub gravity: [f64; 3],
-    /// No free surface (the pressure level is arbitrary).
-    pub internal_flow: bool,
-    /// Wall bodies bound the fluid.
-    pub walls: bool,
     /// A free surface to detect and keep the shifting tangential to.
     pub free_surface: bool,
 }
@@ -111,7 +107,7 @@ pub struct FluidConstants {
 impl FluidConstants {
     /// An internal flow at Reynolds number `re` on velocity `u` and length `l`: viscosity
     /// `u l / re`, summation density, no gravity, no artificial viscosity, an arbitrary
-    /// pressure level and no walls (see [`with_walls`](Self::with_walls)).
+    /// pressure level.
     pub fn internal_flow(rho0: f64, c0: f64, u: f64, l: f64, re: f64, dx: f64) -> Self {
         Self {
             rho0,
@@ -122,15 +118,8 @@ impl FluidConstants {
             alpha: None,
             density: DensityModel::Summation,
             gravity: [0.0; 3],
-            internal_flow: true,
-            walls: false,
             free_surface: false,
         }
-    }
-
-    /// The same fluid bounded by walls.
-    pub fn with_walls(self) -> Self {
-        Self { walls: true, ..self }
     }
 
     /// Water of depth `height` under gravity `g` with a free surface: reference velocity
@@ -147,8 +136,6 @@ impl FluidConstants {
             alpha: Some(alpha),
             density: DensityModel::Continuity,
             gravity: [0.0, -g, 0.0],
-            internal_flow: false,
-            walls: true,
             free_surface: true,
         }
     }
@@ -191,8 +178,6 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
         ipst_max_iter: p.int("ipst_max_iter") as usize,
         ipst_interval: p.int("ipst_interval") as usize,
         gravity: c.gravity,
-        internal_flow: c.internal_flow,
-        walls: c.walls,
         pressure_reference: PressureReference::from_name(p.str("pressure_reference"))
             .expect("checked choice"),
         free_surface: c.free_surface.then(|| {

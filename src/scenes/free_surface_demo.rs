@@ -90,8 +90,6 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         alpha: None,
         density: DensityModel::Continuity,
         gravity: [0.0; 3],
-        internal_flow: false,
-        walls: !walls.is_empty(),
         free_surface: true,
     };
     let (kernel, h, scheme) = fluid_scheme(p, &constants);

@@ -133,6 +133,7 @@ impl<const D: usize> Simulation<D> {
         time_settings: TimeSettings,
         free_surface: bool,
     ) -> Result<Self, String> {
+        scheme.set_walls(wall.is_some());
         let radius = kernel.support() * fluid.h;
         for k in 0..D {
             if domain.periodic[k] && domain.length(k) < 2.0 * radius {

@@ -90,11 +90,11 @@ impl Pst {
 /// BQL; in the lid-driven cavity the level stays near 0.5 rho U^2 under eq. (27), which
 /// keeps the fluid under the lid free of voids, while with BQL voids open there and at
 /// Re = 1000 the fluid leaves the cavity (t = 3.2 s).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PressureReference {
-    /// The scheme's own: BQL for `edac` (as PySPH's EDACScheme) and for `ctvf` on internal
-    /// flows without walls (periodic), none for `tvf` and otherwise.
+    /// The scheme's own ([`SchemeName::bql_by_default`]).
+    #[default]
     Auto,
     /// The neighbours' mean pressure (BQL).
     LocalMean,
@@ -291,6 +291,19 @@ pub struct Transport {
     pub corrections: Corrections,
 }
 
+/// The paper's values of the scheme constants a scene may override (`--set`): alpha_edac of
+/// eq. (24), and IPST's tolerance of eq. (39) and iteration cap, on every step (sec. 3.3.2).
+pub mod paper {
+    /// alpha of nu_edac, eq. (24).
+    pub const EDAC_ALPHA: f64 = 0.5;
+    /// IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39).
+    pub const IPST_TOL: f64 = 0.02;
+    /// IPST moves per step at most.
+    pub const IPST_MAX_ITER: usize = 10;
+    /// IPST on every this many steps (the authors' code uses 5).
+    pub const IPST_INTERVAL: usize = 1;
+}
+
 /// Everything a fluid body's equations depend on: one value per scheme.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FluidScheme {
@@ -300,8 +313,11 @@ pub struct FluidScheme {
     pub density: DensityModel,
     /// Pressure model.
     pub pressure: PressureModel,
-    /// Pressure-gradient form.
+    /// Pressure-gradient form, with its reference resolved by [`set_walls`](Self::set_walls).
     pub pressure_gradient: PressureGradient,
+    /// The reference pressure asked for (`Auto` resolves by the fluid's boundaries).
+    #[serde(default)]
+    pub pressure_reference: PressureReference,
     /// Kinematic viscosity (Morris term), if any.
     pub viscosity: Option<f64>,
     /// Artificial viscosity `(alpha, c)`, if any.
@@ -347,21 +363,17 @@ pub struct FluidSettings {
     pub ipst_interval: usize,
     /// Gravity.
     pub gravity: [f64; 3],
-    /// An internal flow (no free surface): the pressure level is arbitrary.
-    pub internal_flow: bool,
-    /// Wall bodies bound the fluid.
-    pub walls: bool,
-    /// The reference pressure of the pressure gradient.
+    /// The reference pressure of the pressure gradient (`Auto` also depends on the walls,
+    /// which [`Simulation::new`](crate::solver::simulation::Simulation::new) resolves).
     pub pressure_reference: PressureReference,
     /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
     pub free_surface: Option<SurfacePressure>,
 }
 
 impl FluidSettings {
-    /// A viscous internal flow in a periodic box (no walls, no free surface, no gravity)
-    /// with the paper's defaults: summation density, Sun's shifting, every correction,
-    /// alpha_edac = 0.5, IPST tolerance 0.02 with at most 10 moves on every step, and the
-    /// scheme's own pressure reference. `w_dx` is W(dx) for Sun's shifting, `nu` the
+    /// A viscous internal flow (no free surface, no gravity) with the [`paper`]'s defaults:
+    /// summation density, Sun's shifting, every correction, and the scheme's own pressure
+    /// reference. `w_dx` is W(dx) for Sun's shifting, `nu` the
     /// kinematic viscosity.
     pub fn internal_flow(rho0: f64, c0: f64, u_ref: f64, h: f64, w_dx: f64, nu: f64) -> Self {
         Self {
@@ -372,16 +384,14 @@ impl FluidSettings {
             w_dx,
             nu: Some(nu),
             alpha: None,
-            edac_alpha: 0.5,
+            edac_alpha: paper::EDAC_ALPHA,
             density: DensityModel::Summation,
             pst: Pst::Sun,
             corrections: Corrections::ALL,
-            ipst_tol: 0.02,
-            ipst_max_iter: 10,
-            ipst_interval: 1,
+            ipst_tol: paper::IPST_TOL,
+            ipst_max_iter: paper::IPST_MAX_ITER,
+            ipst_interval: paper::IPST_INTERVAL,
             gravity: [0.0; 3],
-            internal_flow: true,
-            walls: false,
             pressure_reference: PressureReference::Auto,
             free_surface: None,
         }
@@ -389,7 +399,21 @@ impl FluidSettings {
 }
 
 impl SchemeName {
-    /// The composition this scheme name stands for.
+    /// Whether the scheme subtracts the neighbours' mean pressure (BQL) under
+    /// `pressure_reference = auto`, for a fluid `bounded` by walls or a free surface. `edac`
+    /// does, as PySPH's EDACScheme; `tvf` does not. `ctvf` does only without boundaries (a
+    /// periodic box: the Taylor-Green vortex needs it), and follows eq. (27) as printed
+    /// otherwise (the lid-driven cavity needs that; see [`PressureReference`]).
+    pub fn bql_by_default(self, bounded: bool) -> bool {
+        match self {
+            SchemeName::Edac => true,
+            SchemeName::Tvf => false,
+            SchemeName::Ctvf => !bounded,
+        }
+    }
+
+    /// The composition this scheme name stands for, for a fluid without walls (see
+    /// [`FluidScheme::set_walls`]).
     pub fn fluid_scheme(self, s: &FluidSettings) -> FluidScheme {
         let artificial_viscosity = s.alpha.filter(|&a| a > 0.0).map(|a| (a, s.c0));
         let edac = PressureModel::Edac {
@@ -404,12 +428,13 @@ impl SchemeName {
             shifting: Shifting::BackgroundPressure { pb: factor * s.rho0 * s.c0 * s.c0 },
             corrections: Corrections::NONE,
         };
-        match self {
+        let mut scheme = match self {
             SchemeName::Edac => FluidScheme {
                 name: self,
                 density: DensityModel::Summation,
                 pressure: edac,
-                pressure_gradient: PressureGradient::Adami { bql: s.pressure_reference.bql(true) },
+                pressure_gradient: PressureGradient::Adami { bql: false },
+                pressure_reference: s.pressure_reference,
                 viscosity: s.nu,
                 artificial_viscosity,
                 transport: Some(background(2.0)),
@@ -420,7 +445,8 @@ impl SchemeName {
                 name: self,
                 density: DensityModel::Summation,
                 pressure: PressureModel::StateEquation { c0: s.c0, rho0: s.rho0 },
-                pressure_gradient: PressureGradient::Adami { bql: s.pressure_reference.bql(false) },
+                pressure_gradient: PressureGradient::Adami { bql: false },
+                pressure_reference: s.pressure_reference,
                 viscosity: s.nu,
                 artificial_viscosity,
                 transport: Some(background(1.0)),
@@ -443,9 +469,8 @@ impl SchemeName {
                     name: self,
                     density: s.density,
                     pressure: edac,
-                    pressure_gradient: PressureGradient::Symmetric {
-                        bql: s.pressure_reference.bql(s.internal_flow && !s.walls),
-                    },
+                    pressure_gradient: PressureGradient::Symmetric { bql: false },
+                    pressure_reference: s.pressure_reference,
                     viscosity: s.nu,
                     artificial_viscosity,
                     transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
@@ -453,11 +478,24 @@ impl SchemeName {
                     free_surface: s.free_surface.map(|pressure| FreeSurface { rho0: s.rho0, pressure }),
                 }
             }
-        }
+        };
+        scheme.set_walls(false);
+        scheme
     }
 }
 
 impl FluidScheme {
+    /// Resolves the pressure reference for a fluid with (or without) walls:
+    /// [`Simulation::new`](crate::solver::simulation::Simulation::new) calls it with its wall
+    /// body, so that a scene declares its walls once, as a body.
+    pub fn set_walls(&mut self, walls: bool) {
+        let bounded = walls || self.free_surface.is_some();
+        let on = self.pressure_reference.bql(self.name.bql_by_default(bounded));
+        match &mut self.pressure_gradient {
+            PressureGradient::Symmetric { bql } | PressureGradient::Adami { bql } => *bql = on,
+        }
+    }
+
     /// Gravity as a `D`-vector.
     pub fn gravity_vector<const D: usize>(&self) -> crate::solver::math::Vector<D> {
         let mut g = crate::solver::math::Vector::<D>::zeros();
@@ -546,8 +584,10 @@ pub(crate) mod tests {
         FluidSettings::internal_flow(1.0, 10.0, 1.0, 0.02, 1.0, 0.01)
     }
 
-    fn bql(name: SchemeName, s: &FluidSettings) -> bool {
-        match name.fluid_scheme(s).pressure_gradient {
+    fn bql(name: SchemeName, s: &FluidSettings, walls: bool) -> bool {
+        let mut scheme = name.fluid_scheme(s);
+        scheme.set_walls(walls);
+        match scheme.pressure_gradient {
             PressureGradient::Symmetric { bql } | PressureGradient::Adami { bql } => bql,
         }
     }
@@ -558,20 +598,21 @@ pub(crate) mod tests {
     #[test]
     fn pressure_reference_per_scheme_and_flow() {
         let periodic = internal_flow_settings();
-        let walled = FluidSettings { walls: true, ..periodic };
-        let free_surface = FluidSettings { internal_flow: false, walls: true, ..periodic };
+        let free_surface = FluidSettings { free_surface: Some(SurfacePressure::Evolve), ..periodic };
         use SchemeName::{Ctvf, Edac, Tvf};
-        for (name, flow, expected) in [
-            (Edac, periodic, true),
-            (Edac, walled, true),
-            (Tvf, periodic, false),
-            (Ctvf, periodic, true),
-            (Ctvf, walled, false),
-            (Ctvf, free_surface, false),
+        for (name, flow, walls, expected) in [
+            (Edac, periodic, false, true),
+            (Edac, periodic, true, true),
+            (Tvf, periodic, false, false),
+            (Ctvf, periodic, false, true),
+            (Ctvf, periodic, true, false),
+            (Ctvf, free_surface, false, false),
+            (Ctvf, free_surface, true, false),
         ] {
-            assert_eq!(bql(name, &flow), expected, "{name:?} {flow:?}");
+            assert_eq!(bql(name, &flow, walls), expected, "{name:?} {flow:?} walls {walls}");
             for (r, on) in [(PressureReference::LocalMean, true), (PressureReference::None, false)] {
-                assert_eq!(bql(name, &FluidSettings { pressure_reference: r, ..flow }), on, "{name:?} {r:?}");
+                let s = FluidSettings { pressure_reference: r, ..flow };
+                assert_eq!(bql(name, &s, walls), on, "{name:?} {r:?}");
             }
         }
         for (k, name) in PressureReference::NAMES.iter().enumerate() {
