@@ -45,7 +45,7 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             "pressure_reference",
             PressureReference::NAMES,
             "auto",
-            "pressure subtracted in the pressure gradient: auto (the scheme's: the neighbour mean (BQL) for edac, and for ctvf in a periodic box), local_mean (BQL) or none (eq. 27 as printed)",
+            "pressure subtracted in the pressure gradient: auto (the scheme's: the neighbour mean (BQL) for edac, and for ctvf in a periodic box), local_mean (BQL), global_mean (the fluid's mean) or none (eq. 27 as printed)",
         ),
         Spec::float("edac_alpha", paper::EDAC_ALPHA, Bound::Positive, "alpha of nu_edac, eq. (24)"),
         Spec::float(

@@ -4,7 +4,10 @@
 //! for any number of threads.
 
 use super::plan::{self, with_accelerations_plan, with_rates_plan};
-use super::{DensityModel, FluidScheme, PressureGradient, PressureModel, Shifting, SurfaceFields, WallSet};
+use super::{
+    DensityModel, FluidScheme, PressureGradient, PressureModel, PressureReference, Shifting, SurfaceFields,
+    WallSet,
+};
 use crate::solver::equations::{
     artificial_viscosity, continuity, edac, free_surface, momentum, shifting, viscosity, Pair, Point,
 };
@@ -273,12 +276,16 @@ impl<const D: usize> FluidPasses<D> {
             _ => 0.0,
         };
         let terms = AccelTerms::new(s);
+        // The fluid's mean pressure, if it is the reference: summed in particle order, so
+        // that it does not depend on the thread count.
+        let global_mean = (s.pressure_reference == PressureReference::GlobalMean)
+            .then(|| fluid.p.iter().sum::<f64>() / fluid.len() as f64);
         let rate = |i: usize| -> (Vector<D>, Vector<D>) {
             let sums = with_accelerations_plan!(terms.plan, P => terms.sums::<P, D>(&src, i));
             let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
-            // BQL: the gradient with the neighbour-mean pressure as reference; the mean is
-            // constant over the sum, so it is applied once here (c_ref is zero without BQL).
-            acc += c_ref * (p_sum / n_nb.max(1) as f64);
+            // A reference pressure (the neighbours' mean for BQL) is constant over the
+            // sum, so it is applied once here (c_ref is zero without one).
+            acc += c_ref * global_mean.unwrap_or(p_sum / n_nb.max(1) as f64);
             if matches!(shifting, Some(Shifting::Sun2019 { .. })) {
                 ac *= sun_prefactor;
             }
@@ -775,10 +782,9 @@ mod tests {
         assert_eq!(rates.len(), plan::RATES.len(), "every compiled plan is one a named scheme takes");
     }
 
-    /// A compiled plan sums exactly what the run-time plan sums, bit for bit, in both
-    /// passes: on a perturbed periodic lattice with varied fields, for every compiled plan.
-    #[test]
-    fn compiled_plans_equal_the_run_time_plan() {
+    /// A perturbed periodic lattice of 12x12 particles with varied fields (and u~ != u),
+    /// with its neighbour list.
+    fn perturbed_lattice() -> (Fluid<2>, KernelList<2>) {
         use crate::solver::kernel::KernelKind;
         use crate::solver::nnps::Domain;
         use crate::solver::particles::FluidInit;
@@ -809,6 +815,49 @@ mod tests {
         cells.update(&fluid.x);
         let mut nl = KernelList::new();
         build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        (fluid, nl)
+    }
+
+    /// A reference pressure removes the pressure level from the accelerations: a uniform
+    /// pressure added to every particle changes them by rounding only with the neighbours'
+    /// or the fluid's mean as reference, and by its zeroth-order gradient error without.
+    #[test]
+    fn a_reference_pressure_removes_the_level() {
+        let (mut fluid, nl) = perturbed_lattice();
+        let accelerations = |fluid: &Fluid<2>, reference: PressureReference| {
+            let settings = FluidSettings {
+                pressure_reference: reference,
+                ..super::super::tests::internal_flow_settings()
+            };
+            let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+            let mut rates = FluidRates::new(fluid.len(), true, false, true);
+            FluidPasses::new().accelerations(fluid, &nl, None, None, &scheme, &mut rates, 1e-3);
+            rates.du
+        };
+        for (reference, removed) in [
+            (PressureReference::LocalMean, true),
+            (PressureReference::GlobalMean, true),
+            (PressureReference::None, false),
+        ] {
+            let before = accelerations(&fluid, reference);
+            fluid.p.iter_mut().for_each(|p| *p += 50.0);
+            let after = accelerations(&fluid, reference);
+            fluid.p.iter_mut().for_each(|p| *p -= 50.0);
+            let scale = before.iter().map(|a| a.norm()).fold(0.0, f64::max);
+            let change = before.iter().zip(&after).map(|(b, a)| (a - b).norm()).fold(0.0, f64::max);
+            if removed {
+                assert!(change < 1e-12 * 50.0 * scale, "{reference:?}: change {change:e}, scale {scale:e}");
+            } else {
+                assert!(change > 0.1 * scale, "{reference:?}: change {change:e}, scale {scale:e}");
+            }
+        }
+    }
+
+    /// A compiled plan sums exactly what the run-time plan sums, bit for bit, in both
+    /// passes: on a perturbed periodic lattice with varied fields, for every compiled plan.
+    #[test]
+    fn compiled_plans_equal_the_run_time_plan() {
+        let (fluid, nl) = perturbed_lattice();
         let mut passes = FluidPasses::new();
         let src = passes.gather(&fluid, &nl, None);
         let accel = AccelTerms { plan: 0, nu: 0.01, av: (0.1, 10.0), pb: 100.0, sun: (2.0, 0.2, 4) };
