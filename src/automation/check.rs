@@ -112,7 +112,7 @@ pub fn status(output: &Path, problems: &[Problem]) -> StatusCounts {
                 State::Failed(_) => n.failed += 1,
                 State::Missing(_) => n.missing += 1,
             }
-            let running = super::lock::Lock::path_for(&e.dir).exists();
+            let running = super::lock::Lock::holder(&e.dir).is_some();
             println!(
                 "  {:<10} {}{}",
                 match st {

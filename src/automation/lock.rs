@@ -32,6 +32,13 @@ impl Lock {
         PathBuf::from(s)
     }
 
+    /// The live process holding the lock of `dir`, if any (a lock left by a dead process
+    /// holds nothing).
+    pub fn holder(dir: &Path) -> Option<u32> {
+        let pid = std::fs::read_to_string(Self::path_for(dir)).ok()?.trim().parse::<u32>().ok()?;
+        alive(pid).then_some(pid)
+    }
+
     /// Tries to lock `dir` once; takes over a lock left by a dead process.
     pub fn try_take(dir: &Path) -> Result<Try, String> {
         let path = Self::path_for(dir);
@@ -94,9 +101,12 @@ mod tests {
             t => panic!("{t:?}"),
         };
         assert!(matches!(Lock::try_take(&case).unwrap(), Try::Held(_)));
+        assert_eq!(Lock::holder(&case), Some(std::process::id()));
         drop(l);
-        // A lock of a dead pid.
+        assert_eq!(Lock::holder(&case), None);
+        // A lock of a dead pid: held by no one, and taken over.
         std::fs::write(Lock::path_for(&case), "4000000000").unwrap();
+        assert_eq!(Lock::holder(&case), None);
         assert!(matches!(Lock::try_take(&case).unwrap(), Try::Taken(_)));
         let _ = std::fs::remove_dir_all(&dir);
     }

@@ -77,7 +77,10 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
                     done += 1;
                     continue;
                 }
-                State::Failed(r) => format!("failed before ({r}): re-run, resuming if it can"),
+                State::Failed(r) => match Lock::holder(&e.dir) {
+                    Some(pid) => format!("running in another runner (pid {pid}): wait for it"),
+                    None => format!("failed before ({r}): re-run, resuming if it can"),
+                },
                 State::Missing(Some(change)) => format!("stale: {change}"),
                 State::Missing(None) => "missing".to_string(),
             };
