@@ -624,6 +624,14 @@ pub(crate) mod tests {
                 assert_eq!(bql(name, &s, walls), on, "{name:?} {r:?}");
             }
         }
+        // A checkpoint written before the field existed reads as `Auto`, its resolved
+        // gradient kept.
+        let mut scheme =
+            Ctvf.fluid_scheme(&FluidSettings { pressure_reference: PressureReference::None, ..periodic });
+        let mut json = serde_json::to_value(scheme).unwrap();
+        json.as_object_mut().unwrap().remove("pressure_reference");
+        scheme.pressure_reference = PressureReference::Auto;
+        assert_eq!(serde_json::from_value::<FluidScheme>(json).unwrap(), scheme);
         for (k, name) in PressureReference::NAMES.iter().enumerate() {
             let r = PressureReference::from_name(name).unwrap();
             assert_eq!(serde_json::to_value(r).unwrap(), PressureReference::NAMES[k]);
