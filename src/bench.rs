@@ -19,8 +19,25 @@ pub struct PeerResult {
     pub threads: usize,
     /// Its particle-steps per second.
     pub particle_steps_per_second: f64,
-    /// The simulated time it ran to (shorter at large nx, so that it takes minutes).
+    /// The simulated time it was asked to run to (shorter at large nx, so that it takes
+    /// minutes).
     pub tf: f64,
+    /// The time it reached, if it says.
+    #[serde(default)]
+    pub t_final: Option<f64>,
+    /// Its L1 velocity error at `t_final` (eq. 66 as PySPH computes it), if it says.
+    #[serde(default)]
+    pub l1_velocity_final: Option<f64>,
+    /// sphrepro `edac`'s L1 velocity error on the same run (size, Re = 100, end time).
+    #[serde(default)]
+    pub sphrepro_l1_velocity_final: Option<f64>,
+}
+
+impl PeerResult {
+    /// The end time both codes are compared at: the peer's, else the one asked for.
+    pub fn end_time(&self) -> f64 {
+        self.t_final.unwrap_or(self.tf)
+    }
 }
 
 /// The simulated time a peer runs at resolution `nx`: t = 2 (the Taylor-Green run)
@@ -31,7 +48,8 @@ pub fn peer_tf(nx: usize) -> f64 {
     (7.0e7 / ((nx * nx) as f64 * steps_per_unit_time)).min(2.0)
 }
 
-/// Reads a peer's one-line JSON report (`particle_steps_per_second` and `peer`).
+/// Reads a peer's one-line JSON report (`particle_steps_per_second`, `peer`, and if there,
+/// `t_final` and `l1_velocity_final`).
 pub fn parse_peer(stdout: &str, nx: usize, threads: usize, tf: f64) -> Result<PeerResult, String> {
     let line = stdout.lines().rev().find(|l| l.trim_start().starts_with('{')).ok_or("no JSON line")?;
     let v: serde_json::Value = serde_json::from_str(line).map_err(|e| format!("unreadable JSON: {e}"))?;
@@ -45,6 +63,9 @@ pub fn parse_peer(stdout: &str, nx: usize, threads: usize, tf: f64) -> Result<Pe
         threads,
         particle_steps_per_second: speed,
         tf,
+        t_final: v["t_final"].as_f64(),
+        l1_velocity_final: v["l1_velocity_final"].as_f64(),
+        sphrepro_l1_velocity_final: None,
     })
 }
 
@@ -146,17 +167,18 @@ pub fn default_steps(n: usize) -> u64 {
 
 /// The benchmark table as Markdown, with the throughput of each variant relative to
 /// `edac` on the same size and threads, and the two-thread speed-up; with peer results, the
-/// peer's throughput and our ratio to it on the same size and threads.
+/// peer's throughput and our ratio to it on the same size and threads, and both L1 velocity
+/// errors at the peer's end time.
 pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
         "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
     );
     if !peers.is_empty() {
-        s.push_str(" peer Mparticle-steps/s | ratio to peer |");
+        s.push_str(" peer Mparticle-steps/s | ratio to peer | L1 at the peer's end time: peer / edac (%) |");
     }
     s.push_str("\n|---|---|---|---|---|---|---|---|---|---|---|---|");
     if !peers.is_empty() {
-        s.push_str("---|---|");
+        s.push_str("---|---|---|");
     }
     s.push('\n');
     for r in results {
@@ -198,15 +220,28 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
         ));
         if !peers.is_empty() {
             match peers.iter().find(|p| p.nx == r.nx && p.threads == r.threads) {
-                Some(p) => s.insert_str(
-                    s.len() - 1,
-                    &format!(
-                        " {:.3} | {:.1}x |",
-                        p.particle_steps_per_second / 1e6,
-                        r.particle_steps_per_second / p.particle_steps_per_second
-                    ),
-                ),
-                None => s.insert_str(s.len() - 1, "  |  |"),
+                Some(p) => {
+                    let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.2}", 100.0 * v));
+                    let l1 = if r.variant == "edac" {
+                        format!(
+                            "{} / {} (t = {:.4})",
+                            pct(p.l1_velocity_final),
+                            pct(p.sphrepro_l1_velocity_final),
+                            p.end_time()
+                        )
+                    } else {
+                        String::new()
+                    };
+                    s.insert_str(
+                        s.len() - 1,
+                        &format!(
+                            " {:.3} | {:.1}x | {l1} |",
+                            p.particle_steps_per_second / 1e6,
+                            r.particle_steps_per_second / p.particle_steps_per_second
+                        ),
+                    )
+                }
+                None => s.insert_str(s.len() - 1, "  |  |  |"),
             }
         }
     }
@@ -227,6 +262,31 @@ mod peer_tests {
         }
     }
 
+    /// The peer columns: its throughput, our ratio to it, and both L1 errors on edac's row.
+    #[test]
+    fn the_table_compares_throughput_and_accuracy_with_the_peer() {
+        let ours = |variant: &str, speed: f64| BenchResult {
+            variant: variant.into(),
+            nx: 50,
+            threads: 2,
+            particles: 2500,
+            steps: 100,
+            seconds: 1.0,
+            particle_steps_per_second: speed,
+            peak_rss_bytes: 0,
+            bytes_per_particle: 0.0,
+            ipst_iterations_mean: 0.0,
+            phase_shares: Default::default(),
+        };
+        let out = "{\"particle_steps_per_second\": 3.0e5, \"l1_velocity_final\": 0.02, \"t_final\": 2.0}";
+        let mut peer = parse_peer(out, 50, 2, 2.0).unwrap();
+        peer.sphrepro_l1_velocity_final = Some(0.0115);
+        let t = table(&[ours("edac", 4.5e6), ours("ctvf+sun", 3.0e6)], &[peer]);
+        let rows: Vec<&str> = t.lines().collect();
+        assert!(rows[2].ends_with("| 0.300 | 15.0x | 2.00 / 1.15 (t = 2.0000) |"), "{}", rows[2]);
+        assert!(rows[3].ends_with("| 0.300 | 10.0x |  |"), "{}", rows[3]);
+    }
+
     #[test]
     fn a_peer_report_is_read_from_its_last_json_line() {
         let out = "installing...\n{\"peer\": \"pysph-1.0b2\", \"particle_steps_per_second\": 3.3e5}\n";
@@ -235,6 +295,10 @@ mod peer_tests {
             (p.peer.as_str(), p.particle_steps_per_second, p.nx, p.threads),
             ("pysph-1.0b2", 3.3e5, 50, 2)
         );
+        assert_eq!((p.end_time(), p.l1_velocity_final), (2.0, None));
+        let out = "{\"particle_steps_per_second\": 3.3e5, \"l1_velocity_final\": 0.02, \"t_final\": 2.0003}";
+        let p = parse_peer(out, 50, 2, 2.0).unwrap();
+        assert_eq!((p.end_time(), p.l1_velocity_final), (2.0003, Some(0.02)));
         assert!(parse_peer("no json", 50, 2, 2.0).is_err());
         assert!(parse_peer("{\"particle_steps_per_second\": 0}", 50, 2, 2.0).is_err());
     }

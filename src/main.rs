@@ -317,6 +317,37 @@ fn run(cli: Cli) -> ExitCode {
     }
 }
 
+/// sphrepro `edac`'s L1 velocity error on a peer's run (Taylor-Green, `nx`, Re = 100, to
+/// `tf`, on `threads` threads), through `simulate` into a temporary folder.
+fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64) -> Result<f64, String> {
+    let dir = std::env::temp_dir().join(format!("sphrepro-bench-l1-{}-{nx}-{threads}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let set = |kv: String| ["--set".to_string(), kv];
+    let mut args =
+        vec!["--threads".to_string(), threads.to_string(), "simulate".into(), "taylor_green".into()];
+    for kv in [
+        format!("nx={nx}"),
+        "re=100".into(),
+        "scheme=edac".into(),
+        format!("tf={tf}"),
+        format!("output_dt={tf}"),
+    ] {
+        args.extend(set(kv));
+    }
+    args.extend(["--quiet".into(), "--out".into(), dir.display().to_string()]);
+    let out = std::process::Command::new(exe).args(&args).output().map_err(|e| e.to_string())?;
+    let summary = std::fs::read(dir.join("summary.json"));
+    let _ = std::fs::remove_dir_all(&dir);
+    if !out.status.success() {
+        return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
+    }
+    let v: serde_json::Value = serde_json::from_slice(&summary.map_err(|e| e.to_string())?)
+        .map_err(|e| format!("summary.json: {e}"))?;
+    v["metrics"]["l1_velocity_final"]
+        .as_f64()
+        .ok_or_else(|| "summary.json: no `l1_velocity_final`".to_string())
+}
+
 fn run_bench(
     nx: Vec<usize>,
     threads: Vec<usize>,
@@ -390,8 +421,24 @@ fn run_bench(
                     Err(e) => Err(e.to_string()),
                 };
                 match parsed {
-                    Ok(p) => {
-                        eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                    Ok(mut p) => {
+                        eprint!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                        match edac_l1(&exe, n, t, p.end_time()) {
+                            Ok(l1) => {
+                                p.sphrepro_l1_velocity_final = Some(l1);
+                                let peer =
+                                    p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
+                                eprintln!(
+                                    "; L1 at t = {:.4}: peer {peer}, edac {:.2} %",
+                                    p.end_time(),
+                                    100.0 * l1
+                                );
+                            }
+                            Err(e) => {
+                                eprintln!("\nerror: edac on the peer's run: {e}");
+                                return ExitCode::from(1);
+                            }
+                        }
                         peers.push(p);
                     }
                     Err(e) => {
