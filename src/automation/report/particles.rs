@@ -8,7 +8,7 @@ use plotters::prelude::*;
 use std::path::Path;
 
 /// Width in pixels of the colour bar panel right of the particles.
-const BAR_PANEL: u32 = 150;
+const BAR_PANEL: u32 = 190;
 const BAR_SAMPLES: usize = 128;
 
 /// Particle positions and one scalar value per particle.
@@ -215,9 +215,9 @@ fn colour_bar<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let mut bar = ChartBuilder::on(area)
         .margin(MARGIN)
-        .margin_right(0)
+        .margin_right(25)
         .x_label_area_size(X_LABEL_AREA)
-        .right_y_label_area_size(BAR_PANEL - 40 - MARGIN)
+        .right_y_label_area_size(BAR_PANEL - 65 - MARGIN)
         .build_cartesian_2d(Axis::Linear(0.0, 1.0), Axis::Linear(lo, hi))
         .map_err(|e| e.to_string())?;
     let step = (hi - lo) / BAR_SAMPLES as f64;
