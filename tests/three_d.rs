@@ -39,8 +39,7 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
         let fluid = Fluid::new("fluid", dx, init.clone(), s.transport.is_some()).unwrap();
         let time = TimeSettings { cfl: 0.25, c0: 10.0, u_ref: 1.0, blowup_factor: 10.0 };
         let mut sim =
-            Simulation::new(Domain::periodic([0.0; 3], [1.0; 3]), kernel, fluid, None, s, time, false)
-                .unwrap();
+            Simulation::new(Domain::periodic([0.0; 3], [1.0; 3]), kernel, fluid, None, s, time).unwrap();
         for _ in 0..20 {
             sim.step(f64::INFINITY).unwrap();
         }

@@ -107,7 +107,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
     let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
-    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time, false)
+    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `cavity`: {e}"))?;
     Ok(Box::new(Cavity {
         sim,

@@ -125,7 +125,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let reach = th + 8.0 * hc;
     let domain = Domain::bounded([-tw, -reach], [2.0 * tw, reach]);
     let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref, blowup_factor: 10.0 };
-    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time, true)
+    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `dam_break`: {e}"))?;
     Ok(Box::new(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() }))
 }

@@ -98,7 +98,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
     let time = TimeSettings { cfl: p.float("cfl"), c0: 10.0, u_ref: 1.0, blowup_factor: 10.0 };
-    let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time, true)
+    let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time)
         .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
     Ok(Box::new(Demo { sim, outer }))
 }

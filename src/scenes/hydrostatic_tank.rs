@@ -81,7 +81,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
     let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: 10.0 };
-    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time, true)
+    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
     Ok(Box::new(Tank { sim, height, width }))
 }

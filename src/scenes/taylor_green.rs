@@ -152,7 +152,7 @@ pub fn simulation(p: &Params) -> Result<Simulation<2>, String> {
     }
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
     let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
-    Simulation::new(domain, kernel, fluid, None, scheme, time, false)
+    Simulation::new(domain, kernel, fluid, None, scheme, time)
         .map_err(|e| format!("scene `taylor_green`: {e}"))
 }
 

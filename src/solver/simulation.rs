@@ -123,7 +123,7 @@ pub struct Simulation<const D: usize> {
 
 impl<const D: usize> Simulation<D> {
     /// Sets up the neighbour search, sorts the particles by cell and evaluates the initial
-    /// rates. `free_surface` selects the IPST reference (sec. 3.3.2).
+    /// rates. The scheme's free surface, if any, selects the IPST reference (sec. 3.3.2).
     pub fn new(
         domain: Domain<D>,
         kernel: Kernel,
@@ -131,7 +131,6 @@ impl<const D: usize> Simulation<D> {
         wall: Option<Wall<D>>,
         mut scheme: FluidScheme,
         time_settings: TimeSettings,
-        free_surface: bool,
     ) -> Result<Self, String> {
         scheme.set_walls(wall.is_some());
         let radius = kernel.support() * fluid.h;
@@ -165,6 +164,7 @@ impl<const D: usize> Simulation<D> {
             times: PhaseTimes::default(),
         };
         sim.rebuild();
+        let free_surface = scheme.free_surface.is_some();
         if let Some(t) = scheme.transport.as_mut() {
             if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
                 *chi_ref =
