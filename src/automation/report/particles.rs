@@ -7,8 +7,11 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::path::Path;
 
-/// Width in pixels of the colour bar panel right of the particles.
+/// Width in pixels of the colour bar panel right of the particles: the bar, its tick
+/// labels and title, and a margin that keeps the title inside the image.
 const BAR_PANEL: u32 = 190;
+const BAR_WIDTH: u32 = 40;
+const BAR_RIGHT_MARGIN: u32 = 25;
 const BAR_SAMPLES: usize = 128;
 
 /// Particle positions and one scalar value per particle.
@@ -215,9 +218,9 @@ fn colour_bar<DB: DrawingBackend>(
 ) -> Result<(), String> {
     let mut bar = ChartBuilder::on(area)
         .margin(MARGIN)
-        .margin_right(25)
+        .margin_right(BAR_RIGHT_MARGIN)
         .x_label_area_size(X_LABEL_AREA)
-        .right_y_label_area_size(BAR_PANEL - 65 - MARGIN)
+        .right_y_label_area_size(BAR_PANEL - BAR_WIDTH - BAR_RIGHT_MARGIN - MARGIN)
         .build_cartesian_2d(Axis::Linear(0.0, 1.0), Axis::Linear(lo, hi))
         .map_err(|e| e.to_string())?;
     let step = (hi - lo) / BAR_SAMPLES as f64;
