@@ -5,7 +5,7 @@
 //! a stale folder can say which input changed.
 
 use super::registry::{Case, Problem};
-use crate::solver::output::summary::{Status, Summary, SCHEME_VERSION};
+use crate::solver::output::summary::{Status, Summary, PART_VERSIONS, SCHEME_VERSION};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::collections::BTreeMap;
@@ -23,6 +23,18 @@ pub fn fingerprint_of(scene: &str) -> String {
         Ok(e) if e.outputs > 0 => format!("{}+{}-outputs{}", fingerprint(), e.name, e.outputs),
         _ => fingerprint(),
     }
+}
+
+/// The fingerprint in the key of a case of `scene` with `params`: [`fingerprint_of`] and the
+/// versions of the parts of the solver the case uses ([`PART_VERSIONS`]).
+pub fn fingerprint_of_case(scene: &str, params: &BTreeMap<String, serde_json::Value>) -> String {
+    let mut f = fingerprint_of(scene);
+    for (key, value, version) in PART_VERSIONS {
+        if params.get(*key).and_then(|v| v.as_str()) == Some(value) {
+            f.push_str(&format!("+{value}{version}"));
+        }
+    }
+    f
 }
 
 /// The inputs of a case, written to `case.json` in its folder.
@@ -46,7 +58,7 @@ impl CaseRecord {
     /// The record of `case` of `problem` for this binary.
     pub fn new(problem: &str, case: &Case) -> Self {
         let params = case.params.to_json();
-        let solver = fingerprint_of(&case.scene);
+        let solver = fingerprint_of_case(&case.scene, &params);
         let canonical = serde_json::json!({
             "scene": case.scene,
             "params": params,
@@ -231,5 +243,20 @@ mod tests {
         let tg = crate::scenes::find("taylor_green").unwrap();
         assert!(tg.outputs > 0 && fingerprint_of("taylor_green") != fingerprint());
         assert_eq!(CaseRecord::new("p", &case(16)).solver, fingerprint_of("taylor_green"));
+    }
+
+    /// A change to IPST alone renews the keys of the IPST cases only.
+    #[test]
+    fn a_part_of_the_solver_renews_only_the_keys_of_cases_that_use_it() {
+        let with = |pst: &str| {
+            let mut c = case(16);
+            c.params.0.insert("pst".into(), Value::Str(pst.into()));
+            CaseRecord::new("p", &c).solver
+        };
+        assert_eq!(with("sun"), fingerprint_of("taylor_green"));
+        assert_eq!(with("none"), fingerprint_of("taylor_green"));
+        assert!(
+            with("ipst").starts_with(&fingerprint_of("taylor_green")) && with("ipst").ends_with("+ipst1")
+        );
     }
 }

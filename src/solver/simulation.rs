@@ -293,6 +293,7 @@ impl<const D: usize> Simulation<D> {
         st.ipst_iterations = self.passes.ipst(
             &st.fluid,
             &self.neighbours,
+            &self.cells,
             walls,
             surface,
             &self.kernel,

@@ -32,19 +32,19 @@ fn powi_small(x: f64, n: i32) -> f64 {
 }
 
 /// One IPST displacement contribution, eq. (37) without `U_max dt`: `V_b n_ab W_ab` with
-/// `n_ab = x_ab / r_ab` (zero for the particle itself), i.e. `x_ab` times
-/// [`ipst_weight`].
+/// `n_ab = x_ab / r_ab` (zero for the particle itself), i.e. `x_ab` times `V_b` times
+/// [`ipst_factor`].
 #[inline(always)]
 pub fn ipst_displacement<const D: usize>(v_b: f64, ab: &Pair<D>) -> Vector<D> {
-    ab.xij * ipst_weight(v_b, ab.wij, ab.r2.sqrt())
+    ab.xij * (v_b * ipst_factor(ab.wij, ab.r2.sqrt()))
 }
 
-/// `V_b W_ab / r_ab` (0 at r = 0), the factor of `x_ab` in eq. (37); on scalars alone so
-/// that a block of pairs evaluates it in one vectorised loop. Takes the neighbour's volume
-/// `v_b`: the iterations move copies of the positions and read nothing else of it.
+/// `W_ab / r_ab` (0 at r = 0): the factor of `V_b x_ab` in eq. (37), the same for both
+/// particles of a pair (`x_ba = -x_ab`), so a sweep evaluates it once per pair. On scalars
+/// alone, so that a block of pairs evaluates it in one vectorised loop.
 #[inline(always)]
-pub fn ipst_weight(v_b: f64, w: f64, r: f64) -> f64 {
-    let f = v_b * w / r;
+pub fn ipst_factor(w: f64, r: f64) -> f64 {
+    let f = w / r;
     if r > 0.0 {
         f
     } else {
@@ -53,7 +53,7 @@ pub fn ipst_weight(v_b: f64, w: f64, r: f64) -> f64 {
 }
 
 /// The IPST uniformity measure of eq. (40), one neighbour's share: `h^2 W_ab` (on
-/// scalars, as [`ipst_weight`]).
+/// scalars, as [`ipst_factor`]).
 #[inline(always)]
 pub fn ipst_chi(h: f64, w: f64) -> f64 {
     h * h * w

@@ -140,6 +140,20 @@ impl<const D: usize> CellList<D> {
         }
     }
 
+    /// Number of cell layers: the cells sharing their coordinate along the last axis,
+    /// which is the slowest in the cell order.
+    pub fn layers(&self) -> usize {
+        self.ncells[D - 1]
+    }
+
+    /// The points binned into layers `layers` (see [`layers`](Self::layers)), as a range of
+    /// the current order: valid after [`mark_reordered`](Self::mark_reordered), when the
+    /// points are in cell order and a layer's points are contiguous.
+    pub fn layer_points(&self, layers: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        let per_layer: usize = self.ncells[..D - 1].iter().product();
+        self.cell_start[layers.start * per_layer] as usize..self.cell_start[layers.end * per_layer] as usize
+    }
+
     /// The cell point `i` was binned into (by the last [`update`](Self::update), in the
     /// current order after [`mark_reordered`](Self::mark_reordered)).
     #[inline(always)]

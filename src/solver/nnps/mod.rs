@@ -13,10 +13,12 @@ mod brute;
 mod cell_list;
 mod filter;
 mod neighbour_list;
+mod slabs;
 
 pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
-pub use neighbour_list::{Listed, NeighbourList, PairSlices};
+pub use neighbour_list::{HalfPairs, Listed, NeighbourList, PairSlices};
+pub use slabs::Slabs;
 
 use crate::solver::math::Vector;
 

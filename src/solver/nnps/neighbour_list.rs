@@ -48,6 +48,23 @@ impl<P> Listed<'_, P> {
     }
 }
 
+/// The pairs `j > i` of a run of points of a [`NeighbourList`], packed as the list packs
+/// them (see [`NeighbourList::half_pairs`]).
+#[derive(Clone, Debug, Default)]
+pub struct HalfPairs {
+    first: usize,
+    start: Vec<u32>,
+    entries: Vec<u32>,
+}
+
+impl HalfPairs {
+    /// Number of pairs `j > i` of point `i`.
+    pub fn count(&self, i: usize) -> usize {
+        let l = i - self.first;
+        (self.start[l + 1] - self.start[l]) as usize
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 struct Chunk<const D: usize, P> {
     start: Vec<u32>,
@@ -339,6 +356,55 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
+    /// Lists the neighbours `j > i` of the points `points` into `half`: each pair once, for
+    /// loops that add its share to both points (see [`Slabs`](super::Slabs)), and that run
+    /// over the pairs several times (the list is then filtered once).
+    pub fn half_pairs(&self, points: std::ops::Range<usize>, half: &mut HalfPairs) {
+        half.first = points.start;
+        half.start.clear();
+        half.entries.clear();
+        for i in points {
+            half.start.push(half.entries.len() as u32);
+            let (chunk, range) = self.range(i);
+            half.entries.extend(chunk.entries[range].iter().filter(|&&e| (e & J_MASK) as usize > i));
+        }
+        half.start.push(half.entries.len() as u32);
+        // Room for a quarter more, as the list keeps, so that later steps do not allocate.
+        let want = half.entries.len() + half.entries.len() / 4 + 256;
+        half.entries.reserve(want.saturating_sub(half.entries.len()));
+    }
+
+    /// As [`write_pairs`](Self::write_pairs) over the pairs `j > i` of point `i` listed in
+    /// `half` (by [`half_pairs`](Self::half_pairs)), with the neighbours' indices in
+    /// `index`. Returns how many were written.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn write_half_pairs(
+        &self,
+        half: &HalfPairs,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        values: &[f64],
+        out: PairSlices<D>,
+        index: &mut [u32],
+    ) -> usize {
+        let l = i - half.first;
+        let entries = &half.entries[half.start[l] as usize..half.start[l + 1] as usize];
+        let n = entries.len();
+        let PairSlices { xij, r2, value } = out;
+        for ((((&e, xij), r2), value), index) in
+            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]).zip(&mut index[..n])
+        {
+            let j;
+            (j, *xij) = self.pair(e, xi, points);
+            *r2 = xij.norm_squared();
+            *value = values[j];
+            *index = j as u32;
+        }
+        n
+    }
+
     /// Total number of (ordered) pairs.
     pub fn pairs(&self) -> usize {
         self.chunks.iter().map(|c| c.entries.len()).sum()
@@ -406,6 +472,30 @@ mod tests {
                 });
             }
             assert_eq!(nl.pairs(), brute.iter().map(|v| v.len()).sum::<usize>());
+            // The half lists of two runs of points hold every pair j > i once, as the
+            // list's own entries.
+            let (mut first, mut second) = (HalfPairs::default(), HalfPairs::default());
+            let split = pts.len() / 3;
+            nl.half_pairs(0..split, &mut first);
+            nl.half_pairs(split..pts.len(), &mut second);
+            let values: Vec<f64> = (0..pts.len()).map(|j| 2.0 * j as f64).collect();
+            for i in 0..pts.len() {
+                let half = if i < split { &first } else { &second };
+                let n = nl.count(i);
+                let (mut xij, mut r2, mut value, mut index) =
+                    (vec![Vector::zeros(); n], vec![0.0; n], vec![0.0; n], vec![0u32; n]);
+                let out = PairSlices { xij: &mut xij, r2: &mut r2, value: &mut value };
+                let m = nl.write_half_pairs(half, i, pts[i], &pts, &values, out, &mut index);
+                assert_eq!(m, half.count(i));
+                let mut expected = Vec::new();
+                nl.for_each(i, &pts, |j, x, d2, _| {
+                    if j > i {
+                        expected.push((j as u32, x, d2, 2.0 * j as f64));
+                    }
+                });
+                let got: Vec<_> = (0..m).map(|k| (index[k], xij[k], r2[k], value[k])).collect();
+                assert_eq!(got, expected, "point {i}");
+            }
         }
     }
 }

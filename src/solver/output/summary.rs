@@ -43,6 +43,13 @@ pub struct Provenance {
 /// support radius (W = 0 there, but the BQL mean pressure counts them).
 pub const SCHEME_VERSION: &str = "3";
 
+/// Versions of parts of the solver that only some cases use, each bumped whenever that
+/// part's results change for unchanged parameters: `(parameter, value, version)`. A case
+/// whose parameter has that value has the version in its cache key; every other case keeps
+/// its results. `pst = ipst`, 1: each fluid pair is evaluated once a sweep and added to
+/// both particles (results change by rounding).
+pub const PART_VERSIONS: &[(&str, &str, u32)] = &[("pst", "ipst", 1)];
+
 impl Provenance {
     /// Provenance of this binary, for a run that started at `started`.
     pub fn now(started: chrono::DateTime<chrono::Utc>) -> Self {

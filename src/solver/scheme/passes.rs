@@ -1,7 +1,9 @@
 //! The parallel loops. Each pass is a gather over the neighbours of every particle of one
 //! body, writing only that particle's own row: a plain rayon loop with no locks or atomics,
 //! and a neighbour order fixed by the neighbour list, so results are bit-for-bit identical
-//! for any number of threads.
+//! for any number of threads. IPST's sweeps, which run up to ten times a step over the same
+//! pairs, evaluate each fluid pair once and add it to both particles instead, in slabs fixed
+//! by the geometry ([`Slabs`]), which keeps that property.
 
 use super::plan::{self, with_accelerations_plan, with_rates_plan};
 use super::{
@@ -13,7 +15,7 @@ use crate::solver::equations::{
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
-use crate::solver::nnps::{CellList, NeighbourList, PairSlices};
+use crate::solver::nnps::{CellList, HalfPairs, NeighbourList, PairSlices, Slabs};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -144,7 +146,10 @@ impl<const D: usize> Sources<'_, D> {
 pub struct FluidPasses<const D: usize> {
     x_shift: Vec<Vector<D>>,
     x_next: Vec<Vector<D>>,
-    ipst_pairs: Vec<IpstPairs<D>>,
+    slabs: Slabs,
+    ipst_slabs: Vec<IpstSlab<D>>,
+    /// Each particle's IPST sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
+    ipst_sums: Vec<(Vector<D>, f64)>,
     vol: Vec<f64>,
     wall_vol: Vec<f64>,
     points: Vec<Point<D>>,
@@ -322,12 +327,16 @@ impl<const D: usize> FluidPasses<D> {
     /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
     /// are those entering the support from outside it during the iterations, whose kernel
     /// value is of the fifth order in the distance they moved in (quintic spline).
-    /// Returns the number of moves made.
+    /// Each fluid pair is evaluated once a sweep and adds to both particles (`W_ab` and
+    /// `r_ab` are symmetric, `x_ba = -x_ab`), in the slabs of `cells` (see [`Slabs`]), so
+    /// that the sums do not depend on the thread count. `cells` must have binned the fluid
+    /// in its current order. Returns the number of moves made.
     #[allow(clippy::too_many_arguments)]
     pub fn ipst(
         &mut self,
         fluid: &Fluid<D>,
         nl: &KernelList<D>,
+        cells: &CellList<D>,
         walls: Option<&WallSet<D>>,
         surface: Option<&SurfaceFields<D>>,
         k: &Kernel,
@@ -350,6 +359,7 @@ impl<const D: usize> FluidPasses<D> {
         self.x_shift.clear();
         self.x_shift.extend_from_slice(&fluid.x);
         self.x_next.resize(n, Vector::zeros());
+        self.ipst_sums.resize(n, (Vector::zeros(), 0.0));
         // The volumes gathered by `accelerations` at these positions, as compact arrays
         // (the sweeps read nothing else of the neighbours).
         self.vol.resize(n, 0.0);
@@ -357,47 +367,57 @@ impl<const D: usize> FluidPasses<D> {
         self.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = pts[i].v());
         self.wall_vol.clear();
         self.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
-        let (vol, wall_vol) = (&self.vol, &self.wall_vol);
+        self.slabs.partition(cells, IPST_SLAB);
+        self.ipst_slabs.resize_with(self.slabs.len(), IpstSlab::default);
+        let slabs = &self.slabs;
+        self.ipst_slabs
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(t, slab)| nl.half_pairs(slabs.range(t), &mut slab.half));
+        // A particle's own share of chi (its pair with itself is not in the half list).
+        let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
+        let (vol, wall_vol, slabs) = (&self.vol, &self.wall_vol, &self.slabs);
+        let walls = walls.map(|ws| (ws, &wall_vol[..]));
         let mut iterations = 0;
         while iterations < max_iter {
-            // One sweep: chi at the current positions (eq. 40) and the moved positions
-            // (eq. 37) into a second buffer, used if chi has not converged.
+            // One sweep: the sums of eqs. (37) and (40) at the current positions, each slab's
+            // pairs in parallel (the shares of other slabs' particles set aside), then the
+            // shares set aside, then chi and the moved positions (eq. 37) into a second
+            // buffer, used if chi has not converged.
             let xs: &[Vector<D>] = &self.x_shift;
-            // In fixed blocks of particles, each with its own pair arrays kept from step to
-            // step (so that the sweeps allocate nothing once they have grown).
-            self.ipst_pairs.resize_with(n.div_ceil(IPST_BLOCK), IpstPairs::default);
-            // Each block returns its largest chi (max is exact: any grouping gives the same).
-            let chi_max = self
-                .x_next
-                .par_chunks_mut(IPST_BLOCK)
-                .zip(self.ipst_pairs.par_iter_mut())
-                .enumerate()
-                .map(|(c, (next, pairs))| {
-                    let mut chi_max = f64::MIN;
-                    for (g, next) in next.chunks_mut(IPST_GROUP).enumerate() {
-                        let first = c * IPST_BLOCK + g * IPST_GROUP;
-                        pairs.evaluate(
-                            first..first + next.len(),
-                            xs,
-                            nl,
-                            vol,
-                            walls.map(|ws| (ws, &wall_vol[..])),
-                            &k,
-                        );
-                        for (l, next) in next.iter_mut().enumerate() {
-                            let i = first + l;
-                            let (d, chi) = pairs.sums(l);
-                            let mut dr = d * (u_max * dt);
-                            if let Some(fs) = surface {
-                                // eq. (45)
-                                dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
-                            }
-                            chi_max = chi_max.max(chi);
-                            // Not wrapped: the list's image shifts refer to the unwrapped positions.
-                            *next = xs[i] + dr;
+            slabs.for_each_mut(&mut self.ipst_sums, &mut self.ipst_slabs, &|t, sums, slab| {
+                slab.sweep(slabs.range(t), sums, xs, nl, vol, walls, &k, chi_self);
+            });
+            let done = &self.ipst_slabs;
+            slabs.for_each_mut(&mut self.ipst_sums, &mut vec![(); slabs.len()], &|t, sums, _| {
+                let range = slabs.range(t);
+                for source in slabs.spill_sources(t) {
+                    for &(j, d, chi) in &done[source].spill {
+                        if let Some(sum) = (j as usize).checked_sub(range.start).and_then(|l| sums.get_mut(l))
+                        {
+                            sum.0 += d;
+                            sum.1 += chi;
                         }
                     }
-                    chi_max
+                }
+            });
+            // The largest chi (max is exact: any grouping gives the same).
+            let sums = &self.ipst_sums;
+            let chi_max = self
+                .x_next
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(LIGHT_LOOP_LEN)
+                .map(|(i, next)| {
+                    let (d, chi) = sums[i];
+                    let mut dr = d * (u_max * dt);
+                    if let Some(fs) = surface {
+                        // eq. (45)
+                        dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                    }
+                    // Not wrapped: the list's image shifts refer to the unwrapped positions.
+                    *next = xs[i] + dr;
+                    chi
                 })
                 .reduce(|| f64::MIN, f64::max);
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
@@ -415,96 +435,172 @@ impl<const D: usize> FluidPasses<D> {
     }
 }
 
-/// Particles per IPST task, each with its own pair arrays (kept from step to step): more
-/// than the passes' `MIN_LEN`, so that the arrays cost a few bytes per particle.
-const IPST_BLOCK: usize = 256;
+/// Fewest particles in an IPST slab: enough that the shares set aside at its edge are a
+/// small part of its pairs and a task is long against rayon's scheduling; few enough that
+/// the two threads have several slabs at nx = 50. Fixed, so that the slabs, and with them
+/// the sums, do not depend on the thread count.
+const IPST_SLAB: usize = 1024;
 /// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
 /// cache level, and the vectorised loops run over the group's pairs, padded once.
 const IPST_GROUP: usize = 8;
 /// Vector lanes the pair arrays are padded to.
 const LANES: usize = 8;
 
-/// The pairs of a group of particles at moved positions, as arrays (reused from group to
-/// group), for the IPST sums of eqs. (37) and (40): the kernel and the weights are
-/// evaluated for all the pairs at once in vectorised loops, then each particle sums its
-/// own in the neighbour order.
+/// One IPST slab's work space, kept from step to step: its pair arrays, and the shares of
+/// its pairs that belong to particles of other slabs, `(j, V_a W_ab x_ba / r, h^2 W_ab)`.
 #[derive(Clone, Debug, Default)]
-struct IpstPairs<const D: usize> {
-    /// Where each particle's pairs end.
-    end: Vec<usize>,
-    xij: Vec<Vector<D>>,
-    /// |x_ij|^2, then |x_ij|.
-    r: Vec<f64>,
-    vol: Vec<f64>,
-    w: Vec<f64>,
-    weight: Vec<f64>,
+struct IpstSlab<const D: usize> {
+    /// The slab's fluid pairs `j > i`, listed once a step.
+    half: HalfPairs,
+    pairs: IpstPairs<D>,
+    spill: Vec<(u32, Vector<D>, f64)>,
 }
 
-impl<const D: usize> IpstPairs<D> {
-    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (volumes `vol`)
-    /// and the walls (with theirs).
-    fn evaluate(
+impl<const D: usize> IpstSlab<D> {
+    /// The slab's share of one sweep: for its particles `particles` (whose sums `sums`
+    /// it zeroes first), each fluid pair `j > i` once, added to both particles (to `j`'s
+    /// spill if `j` is outside the slab), and each wall pair.
+    #[allow(clippy::too_many_arguments)]
+    fn sweep(
         &mut self,
         particles: std::ops::Range<usize>,
+        sums: &mut [(Vector<D>, f64)],
         xs: &[Vector<D>],
         nl: &KernelList<D>,
         vol: &[f64],
         walls: Option<(&WallSet<D>, &[f64])>,
         k: &ScaledKernel,
+        chi_self: f64,
     ) {
-        let to_wall = walls.map(|(ws, _)| &ws.fluid_to_wall);
-        let n: usize = particles.clone().map(|i| nl.count(i) + to_wall.map_or(0, |l| l.count(i))).sum();
-        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
-        // padding holds earlier (finite) values, which no sum reads.
-        let padded = n.next_multiple_of(LANES);
-        if self.r.len() < padded {
-            self.xij.resize(padded, Vector::zeros());
-            for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.weight] {
-                a.resize(padded, 0.0);
+        sums.fill((Vector::zeros(), 0.0));
+        self.spill.clear();
+        let first = particles.start;
+        for group in particles.step_by(IPST_GROUP) {
+            let group = group..(group + IPST_GROUP).min(first + sums.len());
+            let p = &mut self.pairs;
+            p.evaluate(group.clone(), xs, nl, &self.half, vol, walls, k);
+            for (l, i) in group.enumerate() {
+                let (fluid, all) = p.ranges(l);
+                let v_i = vol[i];
+                let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
+                let f = fluid.clone();
+                let pairs = p.xij[f.clone()].iter().zip(&p.factor[f.clone()]).zip(&p.w[f.clone()]);
+                for (((&xij, &f), &w), (&v_j, &j)) in pairs.zip(p.vol[f.clone()].iter().zip(&p.index[f])) {
+                    d += xij * (f * v_j);
+                    chi += w;
+                    // x_ji = -x_ij
+                    let share = xij * -(f * v_i);
+                    let l = j as usize - first;
+                    if l < sums.len() {
+                        sums[l].0 += share;
+                        sums[l].1 += w;
+                    } else {
+                        self.spill.push((j, share, w));
+                    }
+                }
+                for q in all {
+                    d += p.xij[q] * (p.factor[q] * p.vol[q]);
+                    chi += p.w[q];
+                }
+                let sum = &mut sums[i - first];
+                sum.0 += d;
+                sum.1 += chi;
             }
         }
+        // Room for a quarter more shares set aside, so that later sweeps do not allocate.
+        let want = self.spill.len() + self.spill.len() / 4 + 64;
+        self.spill.reserve(want.saturating_sub(self.spill.len()));
+    }
+}
+
+/// The pairs of a group of particles at moved positions, as arrays (reused from group to
+/// group), for the IPST sums of eqs. (37) and (40): for each particle its fluid pairs
+/// `j > i`, then its wall pairs. The kernel and the factors are evaluated for all the pairs
+/// at once in vectorised loops.
+#[derive(Clone, Debug, Default)]
+struct IpstPairs<const D: usize> {
+    /// Where each particle's fluid pairs end, and where its wall pairs end.
+    fluid_end: Vec<usize>,
+    end: Vec<usize>,
+    xij: Vec<Vector<D>>,
+    /// |x_ij|^2, then |x_ij|.
+    r: Vec<f64>,
+    /// The neighbours' volumes and (fluid) indices.
+    vol: Vec<f64>,
+    index: Vec<u32>,
+    /// W_ab, then h^2 W_ab (eq. 40).
+    w: Vec<f64>,
+    /// W_ab / r_ab (eq. 37).
+    factor: Vec<f64>,
+}
+
+impl<const D: usize> IpstPairs<D> {
+    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (volumes `vol`,
+    /// the pairs `j > i` only) and the walls (with theirs).
+    #[allow(clippy::too_many_arguments)]
+    fn evaluate(
+        &mut self,
+        particles: std::ops::Range<usize>,
+        xs: &[Vector<D>],
+        nl: &KernelList<D>,
+        half: &HalfPairs,
+        vol: &[f64],
+        walls: Option<(&WallSet<D>, &[f64])>,
+        k: &ScaledKernel,
+    ) {
+        let to_wall = walls.map(|(ws, _)| &ws.fluid_to_wall);
+        let n: usize = particles.clone().map(|i| half.count(i) + to_wall.map_or(0, |l| l.count(i))).sum();
+        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
+        // padding holds earlier (finite) values, which no sum reads.
+        let room = n.next_multiple_of(LANES);
+        if self.r.len() < room {
+            // A quarter more than needed, so that groups with a few more pairs later on do
+            // not allocate.
+            let grown = (room + room / 4).next_multiple_of(LANES);
+            self.xij.resize(grown, Vector::zeros());
+            self.index.resize(grown, 0);
+            for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.factor] {
+                a.resize(grown, 0.0);
+            }
+        }
+        self.fluid_end.clear();
         self.end.clear();
         let mut at = 0;
         for i in particles {
-            let mut write = |list: &KernelList<D>, sources: &[Vector<D>], vol: &[f64]| {
+            let out =
+                PairSlices { xij: &mut self.xij[at..], r2: &mut self.r[at..], value: &mut self.vol[at..] };
+            at += nl.write_half_pairs(half, i, xs[i], xs, vol, out, &mut self.index[at..]);
+            self.fluid_end.push(at);
+            if let Some((ws, wall_vol)) = walls {
                 let out = PairSlices {
                     xij: &mut self.xij[at..],
                     r2: &mut self.r[at..],
                     value: &mut self.vol[at..],
                 };
-                list.write_pairs(i, xs[i], sources, vol, out);
-                at += list.count(i);
-            };
-            write(nl, xs, vol);
-            if let Some((ws, wall_vol)) = walls {
-                write(&ws.fluid_to_wall, &ws.wall.x, wall_vol);
+                ws.fluid_to_wall.write_pairs(i, xs[i], &ws.wall.x, wall_vol, out);
+                at += ws.fluid_to_wall.count(i);
             }
             self.end.push(at);
         }
+        let padded = room;
         let r = &mut self.r[..padded];
         for r in r.iter_mut() {
             *r = r.sqrt();
         }
         k.w_batch_at_distances(r, &mut self.w[..padded]);
         // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
-        for (((f, &v), w), &r) in self.weight[..padded].iter_mut().zip(&self.vol).zip(&mut self.w).zip(&*r) {
-            *f = shifting::ipst_weight(v, *w, r);
+        for ((f, w), &r) in self.factor[..padded].iter_mut().zip(&mut self.w[..padded]).zip(&*r) {
+            *f = shifting::ipst_factor(*w, r);
             *w = shifting::ipst_chi(k.h, *w);
         }
     }
 
-    /// `(sum V_b n_ab W_ab, sum h^2 W_ab)` of the `l`-th particle of the group last
+    /// The fluid pairs and the wall pairs of the `l`-th particle of the group last
     /// evaluated.
     #[inline(always)]
-    fn sums(&self, l: usize) -> (Vector<D>, f64) {
+    fn ranges(&self, l: usize) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
         let from = if l == 0 { 0 } else { self.end[l - 1] };
-        let to = self.end[l];
-        let (mut d, mut chi) = (Vector::<D>::zeros(), 0.0);
-        for ((&xij, &f), &w) in self.xij[from..to].iter().zip(&self.weight[from..to]).zip(&self.w[from..to]) {
-            d += xij * f;
-            chi += w;
-        }
-        (d, chi)
+        (from..self.fluid_end[l], self.fluid_end[l]..self.end[l])
     }
 }
 
@@ -816,6 +912,83 @@ mod tests {
         let mut nl = KernelList::new();
         build_kernel_list(&mut nl, &cells, &fluid, &kernel);
         (fluid, nl)
+    }
+
+    /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
+    /// slabs, equals the direct sum of every particle over its whole neighbour list (to
+    /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
+    /// bit for bit the same on one and on two threads.
+    #[test]
+    fn ipst_pairs_once_equal_the_direct_sum() {
+        use crate::solver::kernel::KernelKind;
+        use crate::solver::nnps::Domain;
+        use crate::solver::particles::FluidInit;
+        let (n, dx) = (64, 1.0 / 64.0);
+        let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
+        let x: Vec<Vector<2>> = (0..n * n)
+            .map(|k| {
+                let (i, j) = ((k % n) as f64, (k / n) as f64);
+                Vector::<2>::new((i + 0.5 + 0.2 * wave(k, 1.3)) * dx, (j + 0.5 + 0.2 * wave(k, 2.1)) * dx)
+            })
+            .collect();
+        let init = FluidInit {
+            u: vec![Vector::<2>::zeros(); n * n],
+            m: (0..n * n).map(|k| dx * dx * (1.0 + 0.1 * wave(k, 0.9))).collect(),
+            rho: vec![1.0; n * n],
+            p: vec![0.0; n * n],
+            x,
+        };
+        let mut fluid = Fluid::new("f", dx, init, true).unwrap();
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let mut cells = CellList::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel.support() * dx);
+        cells.update(&fluid.x);
+        fluid.reorder(cells.order());
+        cells.mark_reordered();
+        let mut nl = KernelList::new();
+        build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        let settings = FluidSettings {
+            pst: Pst::Ipst,
+            ipst_max_iter: 1,
+            ..super::super::tests::internal_flow_settings()
+        };
+        let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+        let Some(Shifting::Ipst { u_max, .. }) = scheme.transport.map(|t| t.shifting) else {
+            panic!("IPST declared")
+        };
+        let dt = 1e-3;
+        let a_c = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let (mut passes, mut rates) =
+                    (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
+                passes.accelerations(&fluid, &nl, None, None, &scheme, &mut rates, dt);
+                passes.ipst(&fluid, &nl, &cells, None, None, &kernel, &scheme, &mut rates, dt, 0);
+                (rates.a_c, passes.slabs.len())
+            })
+        };
+        let ((one, slabs), (two, _)) = (a_c(1), a_c(2));
+        assert!(slabs >= 3, "{slabs} slabs");
+        assert!(one
+            .iter()
+            .zip(&two)
+            .all(|(a, b)| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits()));
+        let k = kernel.scaled(dx);
+        let mut largest = 0.0f64;
+        for (i, a) in one.iter().enumerate() {
+            let mut d = Vector::<2>::zeros();
+            nl.for_each(i, &fluid.x, |j, xij, r2, _| {
+                let r = r2.sqrt();
+                d += xij * (fluid.m[j] / fluid.rho[j] * shifting::ipst_factor(k.w(r), r));
+            });
+            // eq. (41) of one move of eq. (37)
+            let direct = d * (u_max * dt) * (2.0 / (dt * dt));
+            assert!(
+                (a - direct).norm() <= 1e-9 * direct.norm().max(1e-3),
+                "particle {i}: {a:?} vs {direct:?}"
+            );
+            largest = largest.max(direct.norm());
+        }
+        assert!(largest > 1.0, "the perturbed lattice is shifted ({largest})");
     }
 
     /// A reference pressure removes the pressure level from the accelerations: a uniform

@@ -1,0 +1,189 @@
+//! Slabs: a partition of a body's points, in cell order, into runs of whole cell layers
+//! (the cells sharing their coordinate along the last axis), for loops that evaluate each
+//! pair once and add its share to both points.
+//!
+//! With the points in cell order, the neighbours `j > i` of a point `i` lie in its own layer
+//! or the next one (a cell is at least a search radius wide), or, across a periodic last
+//! axis, in the last layer when `i` is in the first. A loop over the pairs `j > i` of every
+//! slab, the slabs in parallel, adds the shares of the points of its own slab at once and
+//! sets the others aside ("spills"); a second parallel loop adds each slab's spills in a
+//! fixed order. Every sum then runs in an order fixed by the partition, which depends on the
+//! geometry alone: the result does not depend on the number of threads, and no two threads
+//! write the same point.
+
+use super::CellList;
+use std::ops::Range;
+
+/// Slabs of whole cell layers of one body, each with at least a given number of points
+/// (the last may have fewer).
+#[derive(Clone, Debug, Default)]
+pub struct Slabs {
+    /// Slab `s` holds the points `bounds[s]..bounds[s + 1]`.
+    bounds: Vec<usize>,
+}
+
+impl Slabs {
+    /// No slabs.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Partitions the points binned by `cells` (in cell order: after
+    /// [`CellList::mark_reordered`]) into slabs of whole layers, closing a slab as soon as
+    /// it holds at least `min_points`.
+    pub fn partition<const D: usize>(&mut self, cells: &CellList<D>, min_points: usize) {
+        self.bounds.clear();
+        self.bounds.push(0);
+        let mut first = 0;
+        for layer in 0..cells.layers() {
+            let points = cells.layer_points(first..layer + 1);
+            if points.len() >= min_points.max(1) || layer + 1 == cells.layers() {
+                self.bounds.push(points.end);
+                first = layer + 1;
+            }
+        }
+    }
+
+    /// Number of slabs.
+    pub fn len(&self) -> usize {
+        self.bounds.len().saturating_sub(1)
+    }
+
+    /// Whether there are no slabs.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The points of slab `s`.
+    pub fn range(&self, s: usize) -> Range<usize> {
+        self.bounds[s]..self.bounds[s + 1]
+    }
+
+    /// The slabs whose points may receive spills from other slabs' pairs `j > i` for slab
+    /// `t`, in the order they are to be added: the previous slab, then (for the last slab)
+    /// the first one, across a periodic last axis.
+    pub fn spill_sources(&self, t: usize) -> impl Iterator<Item = usize> {
+        let last = self.len().saturating_sub(1);
+        let previous = t.checked_sub(1);
+        let first = (t == last && t > 1).then_some(0);
+        previous.into_iter().chain(first)
+    }
+
+    /// Calls `f(s, data_s, state_s)` for every slab `s` in parallel, with `data_s` the
+    /// slab's part of `data` (one element per point, from the slab's first point) and
+    /// `state[s]`. Allocates nothing.
+    pub fn for_each_mut<T: Send, S: Send, F>(&self, data: &mut [T], state: &mut [S], f: &F)
+    where
+        F: Fn(usize, &mut [T], &mut S) + Sync,
+    {
+        assert_eq!(data.len(), *self.bounds.last().unwrap_or(&0), "one element per point");
+        assert_eq!(state.len(), self.len(), "one state per slab");
+        if !self.is_empty() {
+            split(&self.bounds, 0, data, state, f);
+        }
+    }
+}
+
+/// Halves the slabs `bounds` (the first numbered `first`) until one is left, in parallel.
+fn split<T: Send, S: Send, F>(bounds: &[usize], first: usize, data: &mut [T], state: &mut [S], f: &F)
+where
+    F: Fn(usize, &mut [T], &mut S) + Sync,
+{
+    let n = bounds.len() - 1;
+    if n == 1 {
+        f(first, data, &mut state[0]);
+        return;
+    }
+    let mid = n / 2;
+    let (dl, dr) = data.split_at_mut(bounds[mid] - bounds[0]);
+    let (sl, sr) = state.split_at_mut(mid);
+    rayon::join(
+        || split(&bounds[..=mid], first, dl, sl, f),
+        || split(&bounds[mid..], first + mid, dr, sr, f),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::math::Vector;
+    use crate::solver::nnps::{Domain, NeighbourList};
+
+    /// A perturbed periodic lattice, sorted by cell.
+    fn sorted_lattice(n: usize, radius: f64) -> (CellList<2>, Vec<Vector<2>>) {
+        let dx = 1.0 / n as f64;
+        let mut x: Vec<Vector<2>> = (0..n * n)
+            .map(|k| {
+                let (i, j) = ((k % n) as f64, (k / n) as f64);
+                let jitter = 0.3 * dx * ((k * 7919 % 101) as f64 / 101.0 - 0.5);
+                Vector::from([(i + 0.5) * dx + jitter, ((j + 0.5) * dx - jitter).rem_euclid(1.0)])
+            })
+            .collect();
+        let mut cells = CellList::new(Domain::periodic([0.0; 2], [1.0; 2]), radius);
+        cells.update(&x);
+        x = cells.order().iter().map(|&i| x[i as usize]).collect();
+        cells.mark_reordered();
+        (cells, x)
+    }
+
+    #[test]
+    fn slabs_tile_the_points_in_whole_layers() {
+        let (cells, x) = sorted_lattice(40, 0.08);
+        let mut slabs = Slabs::new();
+        slabs.partition(&cells, 300);
+        assert!(slabs.len() >= 3, "{} slabs", slabs.len());
+        assert_eq!(slabs.range(0).start, 0);
+        assert_eq!(slabs.range(slabs.len() - 1).end, x.len());
+        for s in 0..slabs.len() {
+            let r = slabs.range(s);
+            if s + 1 < slabs.len() {
+                assert!(r.len() >= 300);
+                assert_eq!(r.end, slabs.range(s + 1).start);
+            }
+            // Whole layers: the first point of a slab starts a layer.
+            let layer = |i: usize| cells.cell_of(i) / 12; // 1 / 0.08 -> 12 cells a row
+            if r.start > 0 {
+                assert_ne!(layer(r.start), layer(r.start - 1));
+            }
+        }
+    }
+
+    /// The claim the once-per-pair loops rest on: every neighbour `j > i` of a point is in
+    /// its own slab, or in a slab that names the point's slab among its spill sources.
+    #[test]
+    fn neighbours_after_a_point_lie_in_its_slab_or_one_that_takes_its_spills() {
+        for min_points in [1, 150, 400, 10_000] {
+            let (cells, x) = sorted_lattice(40, 0.08);
+            let mut slabs = Slabs::new();
+            slabs.partition(&cells, min_points);
+            let slab_of = |i: usize| (0..slabs.len()).find(|&s| slabs.range(s).contains(&i)).unwrap();
+            let mut nl = NeighbourList::<2, ()>::new();
+            nl.build(&cells, &x, |_, _| {});
+            for i in 0..x.len() {
+                nl.for_each(i, &x, |j, _, _, _| {
+                    let (s, t) = (slab_of(i), slab_of(j));
+                    if j > i && s != t {
+                        assert!(slabs.spill_sources(t).any(|u| u == s), "{i} in slab {s} -> {j} in {t}");
+                    }
+                });
+            }
+        }
+    }
+
+    #[test]
+    fn each_slab_gets_its_own_part_of_the_data() {
+        let (cells, x) = sorted_lattice(30, 0.1);
+        let mut slabs = Slabs::new();
+        slabs.partition(&cells, 100);
+        let mut data = vec![usize::MAX; x.len()];
+        let mut state = vec![0usize; slabs.len()];
+        slabs.for_each_mut(&mut data, &mut state, &|s, d, n| {
+            d.iter_mut().for_each(|v| *v = s);
+            *n = d.len();
+        });
+        for s in 0..slabs.len() {
+            assert!(data[slabs.range(s)].iter().all(|&v| v == s));
+            assert_eq!(state[s], slabs.range(s).len());
+        }
+    }
+}
