@@ -798,8 +798,11 @@ impl AccelTerms {
                 s.c_ref += momentum::pressure_reference_weight(a, b, ab);
             }
         }
-        s.p_sum += b.p;
-        s.n_nb += 1;
+        if self.has::<P>(plan::BQL) {
+            // The neighbours' mean pressure, the reference of BQL (unused without one).
+            s.p_sum += b.p;
+            s.n_nb += 1;
+        }
         if self.has::<P>(plan::VISCOSITY) {
             s.acc += viscosity::morris(a, b_visc, ab, self.nu);
         }
