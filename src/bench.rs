@@ -74,6 +74,8 @@ pub fn parse_peer(stdout: &str, nx: usize, threads: usize, tf: f64) -> Result<Pe
 pub struct BenchResult {
     /// `edac`, `ctvf+sun`, `ctvf+ipst`.
     pub variant: String,
+    /// The kernel (h/dx = 1).
+    pub kernel: String,
     /// Particles per side.
     pub nx: usize,
     /// Rayon threads.
@@ -117,7 +119,13 @@ fn status_kb(field: &str) -> u64 {
 /// moves a step, with a tolerance it never meets): a developed Taylor-Green flow sits there
 /// (measured at nx = 50 and 100: from t = 0.09 on, every step makes the 10 moves), while
 /// the first steps of a run barely iterate, so timing those would understate its cost.
-pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<BenchResult, String> {
+pub fn run_case(
+    variant: &str,
+    nx: usize,
+    steps: u64,
+    warmup: u64,
+    kernel: &str,
+) -> Result<BenchResult, String> {
     let (_, scheme, pst) = VARIANTS
         .iter()
         .find(|v| v.0 == variant)
@@ -127,6 +135,7 @@ pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<Ben
         &format!("nx={nx}"),
         &format!("scheme={scheme}"),
         &format!("pst={pst}"),
+        &format!("kernel={kernel}"),
         "re=100",
         "perturb=0.05",
         "ipst_tol=1e-12",
@@ -147,6 +156,7 @@ pub fn run_case(variant: &str, nx: usize, steps: u64, warmup: u64) -> Result<Ben
     let hwm = status_kb("VmHWM:") * 1024;
     Ok(BenchResult {
         variant: variant.into(),
+        kernel: kernel.into(),
         nx,
         threads: rayon::current_num_threads(),
         particles: n,
@@ -267,6 +277,7 @@ mod peer_tests {
     fn the_table_compares_throughput_and_accuracy_with_the_peer() {
         let ours = |variant: &str, speed: f64| BenchResult {
             variant: variant.into(),
+            kernel: "quintic_spline".into(),
             nx: 50,
             threads: 2,
             particles: 2500,

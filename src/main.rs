@@ -169,6 +169,9 @@ enum Command {
         /// `particle_steps_per_second`; the table then gives our ratio to it.
         #[arg(long)]
         peer: Option<PathBuf>,
+        /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
+        #[arg(long, default_value = "quintic_spline")]
+        kernel: String,
     },
     /// One benchmark configuration in this process (used by `bench`).
     #[command(hide = true)]
@@ -179,6 +182,8 @@ enum Command {
         nx: usize,
         #[arg(long)]
         steps: u64,
+        #[arg(long, default_value = "quintic_spline")]
+        kernel: String,
     },
 }
 
@@ -301,25 +306,27 @@ fn run(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Bench { nx, bench_threads, variants, steps, json, peer } => {
-            run_bench(nx, bench_threads, variants, steps, json, peer)
+        Command::Bench { nx, bench_threads, variants, steps, json, peer, kernel } => {
+            run_bench(nx, bench_threads, variants, steps, json, peer, &kernel)
         }
-        Command::BenchCase { variant, nx, steps } => match bench::run_case(&variant, nx, steps, 5) {
-            Ok(r) => {
-                println!("{}", serde_json::to_string(&r).expect("serialises"));
-                ExitCode::SUCCESS
+        Command::BenchCase { variant, nx, steps, kernel } => {
+            match bench::run_case(&variant, nx, steps, 5, &kernel) {
+                Ok(r) => {
+                    println!("{}", serde_json::to_string(&r).expect("serialises"));
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: {e}");
+                    ExitCode::from(1)
+                }
             }
-            Err(e) => {
-                eprintln!("error: {e}");
-                ExitCode::from(1)
-            }
-        },
+        }
     }
 }
 
 /// sphrepro `edac`'s L1 velocity error on a peer's run (Taylor-Green, `nx`, Re = 100, to
-/// `tf`, on `threads` threads), through `simulate` into a temporary folder.
-fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64) -> Result<f64, String> {
+/// `tf`, on `threads` threads, with `kernel`), through `simulate` into a temporary folder.
+fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &str) -> Result<f64, String> {
     let dir = std::env::temp_dir().join(format!("sphrepro-bench-l1-{}-{nx}-{threads}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let set = |kv: String| ["--set".to_string(), kv];
@@ -329,6 +336,7 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64) -> Result<
         format!("nx={nx}"),
         "re=100".into(),
         "scheme=edac".into(),
+        format!("kernel={kernel}"),
         format!("tf={tf}"),
         format!("output_dt={tf}"),
     ] {
@@ -355,7 +363,15 @@ fn run_bench(
     steps: Option<u64>,
     json: PathBuf,
     peer: Option<PathBuf>,
+    kernel: &str,
 ) -> ExitCode {
+    if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
+        eprintln!(
+            "error: bench: --kernel {kernel}: expected one of {}",
+            sphrepro::solver::kernel::KernelKind::NAMES.join(", ")
+        );
+        return ExitCode::from(2);
+    }
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
     let exe = std::env::current_exe().expect("own executable");
@@ -376,6 +392,8 @@ fn run_bench(
                         &n.to_string(),
                         "--steps",
                         &k.to_string(),
+                        "--kernel",
+                        kernel,
                     ])
                     .output();
                 match out {
@@ -423,7 +441,7 @@ fn run_bench(
                 match parsed {
                     Ok(mut p) => {
                         eprint!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
-                        match edac_l1(&exe, n, t, p.end_time()) {
+                        match edac_l1(&exe, n, t, p.end_time(), kernel) {
                             Ok(l1) => {
                                 p.sphrepro_l1_velocity_final = Some(l1);
                                 let peer =
@@ -449,6 +467,7 @@ fn run_bench(
             }
         }
     }
+    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1:\n");
     println!("{}", bench::table(&results, &peers));
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {

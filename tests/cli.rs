@@ -214,4 +214,24 @@ fn bench_measures_a_peer_in_the_same_sitting() {
         .unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("broken.sh"));
+    // Another kernel: every case and the accuracy run take it; an unknown one is refused.
+    let out = Command::new(bin)
+        .args(["bench", "--nx", "20", "--bench-threads", "1", "--variants", "edac", "--steps", "5"])
+        .args([
+            "--json",
+            json.to_str().unwrap(),
+            "--peer",
+            good.to_str().unwrap(),
+            "--kernel",
+            "cubic_spline",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["results"][0]["kernel"], "cubic_spline");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("kernel cubic_spline"));
+    let out = Command::new(bin).args(["bench", "--kernel", "spline9"]).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--kernel spline9"));
 }
