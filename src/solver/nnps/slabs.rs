@@ -30,14 +30,15 @@ impl Slabs {
 
     /// Partitions the points binned by `cells` (in cell order: after
     /// [`CellList::mark_reordered`]) into slabs of whole layers, closing a slab as soon as
-    /// it holds at least `min_points`.
-    pub fn partition<const D: usize>(&mut self, cells: &CellList<D>, min_points: usize) {
+    /// it holds at least `min_points` in at least `min_layers` layers.
+    pub fn partition<const D: usize>(&mut self, cells: &CellList<D>, min_points: usize, min_layers: usize) {
         self.bounds.clear();
         self.bounds.push(0);
         let mut first = 0;
         for layer in 0..cells.layers() {
             let points = cells.layer_points(first..layer + 1);
-            if points.len() >= min_points.max(1) || layer + 1 == cells.layers() {
+            let full = points.len() >= min_points.max(1) && layer + 1 - first >= min_layers;
+            if full || layer + 1 == cells.layers() {
                 self.bounds.push(points.end);
                 first = layer + 1;
             }
@@ -130,7 +131,7 @@ mod tests {
     fn slabs_tile_the_points_in_whole_layers() {
         let (cells, x) = sorted_lattice(40, 0.08);
         let mut slabs = Slabs::new();
-        slabs.partition(&cells, 300);
+        slabs.partition(&cells, 300, 1);
         assert!(slabs.len() >= 3, "{} slabs", slabs.len());
         assert_eq!(slabs.range(0).start, 0);
         assert_eq!(slabs.range(slabs.len() - 1).end, x.len());
@@ -155,7 +156,7 @@ mod tests {
         for min_points in [1, 150, 400, 10_000] {
             let (cells, x) = sorted_lattice(40, 0.08);
             let mut slabs = Slabs::new();
-            slabs.partition(&cells, min_points);
+            slabs.partition(&cells, min_points, 2);
             let slab_of = |i: usize| (0..slabs.len()).find(|&s| slabs.range(s).contains(&i)).unwrap();
             let mut nl = NeighbourList::<2, ()>::new();
             nl.build(&cells, &x, |_, _| {});
@@ -174,7 +175,7 @@ mod tests {
     fn each_slab_gets_its_own_part_of_the_data() {
         let (cells, x) = sorted_lattice(30, 0.1);
         let mut slabs = Slabs::new();
-        slabs.partition(&cells, 100);
+        slabs.partition(&cells, 100, 1);
         let mut data = vec![usize::MAX; x.len()];
         let mut state = vec![0usize; slabs.len()];
         slabs.for_each_mut(&mut data, &mut state, &|s, d, n| {

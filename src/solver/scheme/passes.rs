@@ -367,7 +367,7 @@ impl<const D: usize> FluidPasses<D> {
         self.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = pts[i].v());
         self.wall_vol.clear();
         self.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
-        self.slabs.partition(cells, IPST_SLAB);
+        self.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
         self.ipst_slabs.resize_with(self.slabs.len(), IpstSlab::default);
         let slabs = &self.slabs;
         self.ipst_slabs
@@ -440,6 +440,9 @@ impl<const D: usize> FluidPasses<D> {
 /// the two threads have several slabs at nx = 50. Fixed, so that the slabs, and with them
 /// the sums, do not depend on the thread count.
 const IPST_SLAB: usize = 1024;
+/// Fewest cell layers in an IPST slab: the pairs between a slab's last layer and the next
+/// slab's first are set aside, so thin slabs set aside most of theirs.
+const IPST_SLAB_LAYERS: usize = 4;
 /// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
 /// cache level, and the vectorised loops run over the group's pairs, padded once.
 const IPST_GROUP: usize = 8;
