@@ -32,6 +32,10 @@ impl Slabs {
     /// [`CellList::mark_reordered`]) into slabs of whole layers, closing a slab as soon as
     /// it holds at least `min_points` in at least `min_layers` layers.
     pub fn partition<const D: usize>(&mut self, cells: &CellList<D>, min_points: usize, min_layers: usize) {
+        debug_assert!(
+            cells.order().iter().enumerate().all(|(k, &i)| k == i as usize),
+            "slabs need the points in cell order"
+        );
         self.bounds.clear();
         self.bounds.push(0);
         let mut first = 0;
