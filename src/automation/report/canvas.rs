@@ -216,9 +216,21 @@ pub(crate) fn save<F: Render>(fig: &F, stem: &Path) -> Result<(), String> {
 fn draw_on<F: Render, DB: DrawingBackend>(fig: &F, backend: DB) -> Result<(), String> {
     let root = backend.into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    let area = root.titled(fig.title(), text(TITLE_SIZE)).map_err(|e| e.to_string())?;
+    let area = root.titled(fig.title(), text(title_size(&root, fig.title()))).map_err(|e| e.to_string())?;
     fig.render(&area)?;
     root.present().map_err(|e| e.to_string())
+}
+
+/// The title's font size: [`TITLE_SIZE`], or smaller (down to [`TICK_SIZE`]) so that a
+/// long title fits the canvas with a margin on each side instead of being cut at its edges.
+fn title_size<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str) -> u32 {
+    let room = root.dim_in_pixel().0.saturating_sub(2 * MARGIN);
+    let width = root.estimate_text_size(title, &text(TITLE_SIZE)).map_or(0, |(w, _)| w);
+    if width <= room {
+        TITLE_SIZE
+    } else {
+        (TITLE_SIZE * room / width).max(TICK_SIZE)
+    }
 }
 
 /// The chart type every figure draws on.
@@ -368,6 +380,22 @@ pub(crate) fn key<DB: DrawingBackend>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A title wider than the canvas is set smaller so that it fits; a short one keeps the
+    /// title size.
+    #[test]
+    fn a_long_title_is_set_smaller_to_fit() {
+        ensure_registered();
+        let mut buf = vec![0u8; 900 * 600 * 3];
+        let root = BitMapBackend::with_buffer(&mut buf, (900, 600)).into_drawing_area();
+        assert_eq!(title_size(&root, "Taylor-Green, Re = 100"), TITLE_SIZE);
+        let long = "Taylor-Green, Re = 100, CTVF with SPST: kernels, accuracy against cost: \
+                    l1_velocity_mean against wall time (s)";
+        let size = title_size(&root, long);
+        assert!(size < TITLE_SIZE);
+        let (w, _) = root.estimate_text_size(long, &text(size)).unwrap();
+        assert!(w <= 900 - 2 * MARGIN + 2, "{w} pixels at {size}");
+    }
 
     #[test]
     fn tick_formatting() {
