@@ -222,9 +222,10 @@ fn draw_on<F: Render, DB: DrawingBackend>(fig: &F, backend: DB) -> Result<(), St
 }
 
 /// The title's font size: [`TITLE_SIZE`], or smaller (down to [`TICK_SIZE`]) so that a
-/// long title fits the canvas with a margin on each side instead of being cut at its edges.
+/// long title fits the canvas with margins instead of being cut at its edges.
 fn title_size<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str) -> u32 {
-    let room = root.dim_in_pixel().0.saturating_sub(2 * MARGIN);
+    // Two margins on each side: the font's estimate runs a few per cent short.
+    let room = root.dim_in_pixel().0.saturating_sub(4 * MARGIN);
     let width = root.estimate_text_size(title, &text(TITLE_SIZE)).map_or(0, |(w, _)| w);
     if width <= room {
         TITLE_SIZE
@@ -394,7 +395,7 @@ mod tests {
         let size = title_size(&root, long);
         assert!(size < TITLE_SIZE);
         let (w, _) = root.estimate_text_size(long, &text(size)).unwrap();
-        assert!(w <= 900 - 2 * MARGIN + 2, "{w} pixels at {size}");
+        assert!(w <= 900 - 4 * MARGIN + 2, "{w} pixels at {size}");
     }
 
     #[test]
