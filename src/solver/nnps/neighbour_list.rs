@@ -60,8 +60,14 @@ pub struct HalfPairs {
 impl HalfPairs {
     /// Number of pairs `j > i` of point `i`.
     pub fn count(&self, i: usize) -> usize {
+        self.entries(i).len()
+    }
+
+    /// The packed entries of point `i`'s pairs `j > i`.
+    #[inline(always)]
+    fn entries(&self, i: usize) -> &[u32] {
         let l = i - self.first;
-        (self.start[l + 1] - self.start[l]) as usize
+        &self.entries[self.start[l] as usize..self.start[l + 1] as usize]
     }
 }
 
@@ -343,17 +349,34 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         out: PairSlices<D>,
     ) {
         let (chunk, range) = self.range(i);
-        let entries = &chunk.entries[range];
+        self.write_entries(&chunk.entries[range], xi, points, values, out, |_, _| {});
+    }
+
+    /// Writes the pairs of `entries` from a query at `xi` into `out` (as
+    /// [`write_pairs`](Self::write_pairs) describes), calling `record(k, j)` with each
+    /// pair's slot and neighbour; returns how many.
+    #[inline(always)]
+    fn write_entries(
+        &self,
+        entries: &[u32],
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        values: &[f64],
+        out: PairSlices<D>,
+        mut record: impl FnMut(usize, usize),
+    ) -> usize {
         let n = entries.len();
         let PairSlices { xij, r2, value } = out;
-        for (((&e, xij), r2), value) in
-            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n])
+        for (k, (((&e, xij), r2), value)) in
+            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]).enumerate()
         {
             let j;
             (j, *xij) = self.pair(e, xi, points);
             *r2 = xij.norm_squared();
             *value = values[j];
+            record(k, j);
         }
+        n
     }
 
     /// Lists the neighbours `j > i` of the points `points` into `half`: each pair once, for
@@ -389,20 +412,8 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         out: PairSlices<D>,
         index: &mut [u32],
     ) -> usize {
-        let l = i - half.first;
-        let entries = &half.entries[half.start[l] as usize..half.start[l + 1] as usize];
-        let n = entries.len();
-        let PairSlices { xij, r2, value } = out;
-        for ((((&e, xij), r2), value), index) in
-            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]).zip(&mut index[..n])
-        {
-            let j;
-            (j, *xij) = self.pair(e, xi, points);
-            *r2 = xij.norm_squared();
-            *value = values[j];
-            *index = j as u32;
-        }
-        n
+        let index = &mut index[..half.count(i)];
+        self.write_entries(half.entries(i), xi, points, values, out, |k, j| index[k] = j as u32)
     }
 
     /// Total number of (ordered) pairs.

@@ -483,25 +483,27 @@ impl<const D: usize> IpstSlab<D> {
             let p = &mut self.pairs;
             p.evaluate(group.clone(), xs, nl, &self.half, vol, walls, k);
             for (l, i) in group.enumerate() {
-                let (fluid, all) = p.ranges(l);
+                let (fluid, wall) = p.ranges(l);
                 let v_i = vol[i];
                 let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
-                let f = fluid.clone();
-                let pairs = p.xij[f.clone()].iter().zip(&p.factor[f.clone()]).zip(&p.w[f.clone()]);
-                for (((&xij, &f), &w), (&v_j, &j)) in pairs.zip(p.vol[f.clone()].iter().zip(&p.index[f])) {
+                let (pair_x, pair_f, pair_w) =
+                    (&p.xij[fluid.clone()], &p.factor[fluid.clone()], &p.w[fluid.clone()]);
+                let (pair_v, pair_j) = (&p.vol[fluid.clone()], &p.index[fluid]);
+                let pairs = pair_x.iter().zip(pair_f).zip(pair_w).zip(pair_v.iter().zip(pair_j));
+                for (((&xij, &f), &w), (&v_j, &j)) in pairs {
                     d += xij * (f * v_j);
                     chi += w;
                     // x_ji = -x_ij
                     let share = xij * -(f * v_i);
-                    let l = j as usize - first;
-                    if l < sums.len() {
-                        sums[l].0 += share;
-                        sums[l].1 += w;
+                    let slot = j as usize - first;
+                    if slot < sums.len() {
+                        sums[slot].0 += share;
+                        sums[slot].1 += w;
                     } else {
                         self.spill.push((j, share, w));
                     }
                 }
-                for q in all {
+                for q in wall {
                     d += p.xij[q] * (p.factor[q] * p.vol[q]);
                     chi += p.w[q];
                 }
@@ -585,14 +587,13 @@ impl<const D: usize> IpstPairs<D> {
             }
             self.end.push(at);
         }
-        let padded = room;
-        let r = &mut self.r[..padded];
+        let r = &mut self.r[..room];
         for r in r.iter_mut() {
             *r = r.sqrt();
         }
-        k.w_batch_at_distances(r, &mut self.w[..padded]);
+        k.w_batch_at_distances(r, &mut self.w[..room]);
         // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
-        for ((f, w), &r) in self.factor[..padded].iter_mut().zip(&mut self.w[..padded]).zip(&*r) {
+        for ((f, w), &r) in self.factor[..room].iter_mut().zip(&mut self.w[..room]).zip(&*r) {
             *f = shifting::ipst_factor(*w, r);
             *w = shifting::ipst_chi(k.h, *w);
         }
