@@ -170,7 +170,7 @@ enum Command {
         #[arg(long)]
         peer: Option<PathBuf>,
         /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
-        #[arg(long, default_value = "quintic_spline")]
+        #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
     },
     /// One benchmark configuration in this process (used by `bench`).
@@ -182,7 +182,7 @@ enum Command {
         nx: usize,
         #[arg(long)]
         steps: u64,
-        #[arg(long, default_value = "quintic_spline")]
+        #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
     },
 }
