@@ -18,7 +18,7 @@ mod slabs;
 pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
 pub use neighbour_list::{HalfPairs, Listed, NeighbourList, PairSlices};
-pub use slabs::Slabs;
+pub use slabs::{PerPoint, Slabs};
 
 use crate::solver::math::Vector;
 

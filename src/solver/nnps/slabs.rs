@@ -75,13 +75,13 @@ impl Slabs {
     }
 
     /// Calls `f(s, data_s, state_s)` for every slab `s` in parallel, with `data_s` the
-    /// slab's part of `data` (one element per point, from the slab's first point) and
-    /// `state[s]`. Allocates nothing.
-    pub fn for_each_mut<T: Send, S: Send, F>(&self, data: &mut [T], state: &mut [S], f: &F)
+    /// slab's part of `data` (one element per point, from the slab's first point; a pair of
+    /// such slices is split alike) and `state[s]`. Allocates nothing.
+    pub fn for_each_mut<T: PerPoint, S: Send, F>(&self, data: T, state: &mut [S], f: &F)
     where
-        F: Fn(usize, &mut [T], &mut S) + Sync,
+        F: Fn(usize, T, &mut S) + Sync,
     {
-        assert_eq!(data.len(), *self.bounds.last().unwrap_or(&0), "one element per point");
+        assert_eq!(data.points(), *self.bounds.last().unwrap_or(&0), "one element per point");
         assert_eq!(state.len(), self.len(), "one state per slab");
         if !self.is_empty() {
             split(&self.bounds, 0, data, state, f);
@@ -89,10 +89,41 @@ impl Slabs {
     }
 }
 
+/// Data with one element per point that a loop over slabs hands out in parts: a mutable
+/// slice, or a pair of them.
+pub trait PerPoint: Send + Sized {
+    /// Number of points.
+    fn points(&self) -> usize;
+    /// The first `k` points' part and the rest.
+    fn split_at(self, k: usize) -> (Self, Self);
+}
+
+impl<T: Send> PerPoint for &mut [T] {
+    fn points(&self) -> usize {
+        self.len()
+    }
+
+    fn split_at(self, k: usize) -> (Self, Self) {
+        self.split_at_mut(k)
+    }
+}
+
+impl<A: PerPoint, B: PerPoint> PerPoint for (A, B) {
+    fn points(&self) -> usize {
+        debug_assert_eq!(self.0.points(), self.1.points());
+        self.0.points()
+    }
+
+    fn split_at(self, k: usize) -> (Self, Self) {
+        let ((a0, a1), (b0, b1)) = (self.0.split_at(k), self.1.split_at(k));
+        ((a0, b0), (a1, b1))
+    }
+}
+
 /// Halves the slabs `bounds` (the first numbered `first`) until one is left, in parallel.
-fn split<T: Send, S: Send, F>(bounds: &[usize], first: usize, data: &mut [T], state: &mut [S], f: &F)
+fn split<T: PerPoint, S: Send, F>(bounds: &[usize], first: usize, data: T, state: &mut [S], f: &F)
 where
-    F: Fn(usize, &mut [T], &mut S) + Sync,
+    F: Fn(usize, T, &mut S) + Sync,
 {
     let n = bounds.len() - 1;
     if n == 1 {
@@ -100,7 +131,7 @@ where
         return;
     }
     let mid = n / 2;
-    let (dl, dr) = data.split_at_mut(bounds[mid] - bounds[0]);
+    let (dl, dr) = data.split_at(bounds[mid] - bounds[0]);
     let (sl, sr) = state.split_at_mut(mid);
     rayon::join(
         || split(&bounds[..=mid], first, dl, sl, f),
@@ -182,13 +213,24 @@ mod tests {
         slabs.partition(&cells, 100, 1);
         let mut data = vec![usize::MAX; x.len()];
         let mut state = vec![0usize; slabs.len()];
-        slabs.for_each_mut(&mut data, &mut state, &|s, d, n| {
+        slabs.for_each_mut(&mut data[..], &mut state, &|s, d: &mut [usize], n| {
             d.iter_mut().for_each(|v| *v = s);
             *n = d.len();
         });
         for s in 0..slabs.len() {
             assert!(data[slabs.range(s)].iter().all(|&v| v == s));
             assert_eq!(state[s], slabs.range(s).len());
+        }
+        // A pair of slices is split alike.
+        let mut other = vec![0.0; x.len()];
+        slabs.for_each_mut((&mut data[..], &mut other[..]), &mut state, &|s, (d, o), n| {
+            assert_eq!(d.len(), o.len());
+            assert!(d.iter().all(|&v| v == s), "slab {s} got another slab's part");
+            o.iter_mut().for_each(|v| *v = s as f64);
+            *n = o.len();
+        });
+        for s in 0..slabs.len() {
+            assert!(other[slabs.range(s)].iter().all(|&v| v == s as f64));
         }
     }
 }

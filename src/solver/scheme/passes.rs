@@ -150,6 +150,8 @@ pub struct FluidPasses<const D: usize> {
     ipst_slabs: Vec<IpstSlab<D>>,
     /// Each particle's IPST sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
     ipst_sums: Vec<(Vector<D>, f64)>,
+    /// Each slab's largest chi in the last sweep.
+    slab_chi_max: Vec<f64>,
     vol: Vec<f64>,
     wall_vol: Vec<f64>,
     points: Vec<Point<D>>,
@@ -369,6 +371,7 @@ impl<const D: usize> FluidPasses<D> {
         self.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
         self.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
         self.ipst_slabs.resize_with(self.slabs.len(), IpstSlab::default);
+        self.slab_chi_max.resize(self.slabs.len(), f64::MIN);
         let slabs = &self.slabs;
         self.ipst_slabs
             .par_iter_mut()
@@ -381,15 +384,16 @@ impl<const D: usize> FluidPasses<D> {
         let mut iterations = 0;
         while iterations < max_iter {
             // One sweep: the sums of eqs. (37) and (40) at the current positions, each slab's
-            // pairs in parallel (the shares of other slabs' particles set aside), then the
-            // shares set aside, then chi and the moved positions (eq. 37) into a second
-            // buffer, used if chi has not converged.
+            // pairs in parallel (the shares of other slabs' particles set aside); then, slab by
+            // slab in parallel, the shares set aside, chi and the moved positions (eq. 37) into
+            // a second buffer, used if chi has not converged.
             let xs: &[Vector<D>] = &self.x_shift;
-            slabs.for_each_mut(&mut self.ipst_sums, &mut self.ipst_slabs, &|t, sums, slab| {
+            slabs.for_each_mut(&mut self.ipst_sums[..], &mut self.ipst_slabs, &|t, sums, slab| {
                 slab.sweep(slabs.range(t), sums, xs, nl, vol, walls, &k, chi_self);
             });
             let done = &self.ipst_slabs;
-            slabs.for_each_mut(&mut self.ipst_sums, &mut vec![(); slabs.len()], &|t, sums, _| {
+            let data = (&mut self.ipst_sums[..], &mut self.x_next[..]);
+            slabs.for_each_mut(data, &mut self.slab_chi_max, &|t, (sums, next), chi_max| {
                 let range = slabs.range(t);
                 for source in slabs.spill_sources(t) {
                     for &(j, d, chi) in &done[source].spill {
@@ -400,16 +404,8 @@ impl<const D: usize> FluidPasses<D> {
                         }
                     }
                 }
-            });
-            // The largest chi (max is exact: any grouping gives the same).
-            let sums = &self.ipst_sums;
-            let chi_max = self
-                .x_next
-                .par_iter_mut()
-                .enumerate()
-                .with_min_len(LIGHT_LOOP_LEN)
-                .map(|(i, next)| {
-                    let (d, chi) = sums[i];
+                *chi_max = f64::MIN;
+                for ((i, &(d, chi)), next) in range.zip(sums.iter()).zip(next) {
                     let mut dr = d * (u_max * dt);
                     if let Some(fs) = surface {
                         // eq. (45)
@@ -417,9 +413,11 @@ impl<const D: usize> FluidPasses<D> {
                     }
                     // Not wrapped: the list's image shifts refer to the unwrapped positions.
                     *next = xs[i] + dr;
-                    chi
-                })
-                .reduce(|| f64::MIN, f64::max);
+                    *chi_max = chi_max.max(chi);
+                }
+            });
+            // The largest chi (max is exact: any grouping gives the same).
+            let chi_max = self.slab_chi_max.iter().fold(f64::MIN, |m, &c| m.max(c));
             if (chi_max - chi_ref).abs() <= tol * chi_ref {
                 break;
             }
