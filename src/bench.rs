@@ -143,7 +143,7 @@ pub fn run_case(
         "perturb=0.05",
         "ipst_tol=1e-12",
     ])?;
-    let mut sim = taylor_green::simulation(&p)?;
+    let mut sim = taylor_green::simulation::<2>(&p)?;
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }

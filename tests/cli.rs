@@ -39,6 +39,8 @@ fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
         ("taylor_green", &["nx"], &["nx"]),
         // A box too small for the kernel support is a parameter error, not a panic.
         ("taylor_green", &["nx=4"], &["nx"]),
+        ("taylor_green_3d", &["nz=4"], &["nz", "4"]),
+        ("taylor_green_3d", &["nz=0"], &["nz", "0"]),
         ("no_such_scene", &[], &["no_such_scene"]),
     ];
     for (scene, sets, words) in cases {

@@ -87,7 +87,7 @@ fn one_and_two_threads_give_identical_bits() {
         let state = |threads: usize| {
             let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
             pool.install(|| {
-                let mut sim = taylor_green::simulation(&p).unwrap();
+                let mut sim = taylor_green::simulation::<2>(&p).unwrap();
                 sim.advance(0.1, 0.1, |_| true).unwrap();
                 let f = sim.fluid();
                 let bits = |v: &[f64]| f.by_id(v).iter().map(|x| x.to_bits()).collect::<Vec<u64>>();
@@ -150,7 +150,7 @@ fn ipst_runs_on_every_interval_th_step_only() {
     for interval in [1u64, 5] {
         let i = format!("ipst_interval={interval}");
         let params = taylor_green::params_from(&[&sets[..], &[i.as_str()]].concat()).unwrap();
-        let mut sim = taylor_green::simulation(&params).unwrap();
+        let mut sim = taylor_green::simulation::<2>(&params).unwrap();
         assert_eq!(sim.last_ipst_iterations(), 3, "the first step shifts");
         for _ in 0..12 {
             sim.step(f64::INFINITY).unwrap();

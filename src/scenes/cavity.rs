@@ -98,7 +98,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let re = p.float("re");
     let dx = L / nx as f64;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
-    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };

@@ -152,10 +152,11 @@ pub fn require_free_surface_scheme(scene: &str, p: &Params) -> Result<(), String
     ))
 }
 
-/// The kernel, smoothing length and scheme the parameters ask for.
-pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme) {
+/// The kernel (normalised in `D` dimensions), smoothing length and scheme the parameters
+/// ask for.
+pub fn fluid_scheme<const D: usize>(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme) {
     let h = p.float("hdx") * c.dx;
-    let kernel = Kernel::new(KernelKind::from_name(p.str("kernel")).expect("checked choice"), 2);
+    let kernel = Kernel::new(KernelKind::from_name(p.str("kernel")).expect("checked choice"), D);
     let all = p.str("corrections") == "all";
     let corrections = Corrections {
         continuity: switch(p, "corr_continuity", all),
@@ -189,12 +190,13 @@ pub fn fluid_scheme(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme
     (kernel, h, scheme)
 }
 
-fn pad(v: &Vector<2>) -> [f64; 3] {
-    [v[0], v[1], 0.0]
+/// A `D`-vector as the three components ParaView reads (zeros beyond `D`).
+fn pad<const D: usize>(v: &Vector<D>) -> [f64; 3] {
+    std::array::from_fn(|k| if k < D { v[k] } else { 0.0 })
 }
 
 /// Writes a fluid snapshot with velocity, speed, pressure, density, id and `extra` fields.
-pub fn write_fluid(path: &Path, f: &Fluid<2>, extra: Vec<Field>) -> std::io::Result<()> {
+pub fn write_fluid<const D: usize>(path: &Path, f: &Fluid<D>, extra: Vec<Field>) -> std::io::Result<()> {
     let mut fields = vec![
         Field::Vector("velocity", f.u.iter().map(pad).collect()),
         Field::Scalar("speed", f.u.iter().map(|u| u.norm()).collect()),
@@ -207,7 +209,7 @@ pub fn write_fluid(path: &Path, f: &Fluid<2>, extra: Vec<Field>) -> std::io::Res
 }
 
 /// Writes a wall snapshot: prescribed velocity, extrapolated pressure and density, normal.
-pub fn write_wall(path: &Path, w: &Wall<2>) -> std::io::Result<()> {
+pub fn write_wall<const D: usize>(path: &Path, w: &Wall<D>) -> std::io::Result<()> {
     write_vtu(
         path,
         &w.x.iter().map(pad).collect::<Vec<_>>(),
@@ -239,7 +241,7 @@ pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize
 }
 
 /// The [`SceneRun`](super::SceneRun) methods every scene forwards to its `sim` field
-/// (a `Simulation<2>`): particle count, time, steps, advancing.
+/// (a `Simulation<D>`): particle count, time, steps, advancing.
 macro_rules! forward_to_sim {
     () => {
         fn particles(&self) -> usize {
@@ -265,7 +267,7 @@ pub(crate) use forward_to_sim;
 
 /// The plan written at the top of a run log: the bodies (with `setting`, e.g. the walls'
 /// layout) and the scheme with every term it evaluates.
-pub fn plan(sim: &Simulation<2>, setting: &str) -> String {
+pub fn plan<const D: usize>(sim: &Simulation<D>, setting: &str) -> String {
     let f = sim.fluid();
     let walls =
         sim.walls.as_ref().map_or(String::new(), |w| format!("; body `wall`: {} particles", w.wall.len()));
@@ -279,14 +281,14 @@ pub fn plan(sim: &Simulation<2>, setting: &str) -> String {
 }
 
 /// Particles in every body of `sim`.
-pub fn particle_count(sim: &Simulation<2>) -> usize {
+pub fn particle_count<const D: usize>(sim: &Simulation<D>) -> usize {
     sim.fluid().len() + sim.walls.as_ref().map_or(0, |w| w.wall.len())
 }
 
 /// Writes the snapshots of every body of `sim` (the fluid with `extra` fields) for output
 /// number `index`; returns the (body, file) pairs.
-pub fn snapshot_bodies(
-    sim: &Simulation<2>,
+pub fn snapshot_bodies<const D: usize>(
+    sim: &Simulation<D>,
     dir: &Path,
     index: usize,
     extra: Vec<Field>,
@@ -303,7 +305,7 @@ pub fn snapshot_bodies(
 }
 
 /// Restores `sim` from the `sim` entry of a scene's checkpoint.
-pub fn restore_sim(sim: &mut Simulation<2>, state: &serde_json::Value) -> Result<(), String> {
+pub fn restore_sim<const D: usize>(sim: &mut Simulation<D>, state: &serde_json::Value) -> Result<(), String> {
     sim.restore(serde_json::from_value(state["sim"].clone()).map_err(|e| format!("checkpoint: {e}"))?);
     Ok(())
 }

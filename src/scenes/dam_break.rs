@@ -110,7 +110,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     require_free_surface_scheme("dam_break", p)?;
     let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
     let (c0, u_ref) = (constants.c0, constants.u_ref);
-    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
     check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);
     let fluid =

@@ -92,7 +92,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         gravity: [0.0; 3],
         free_surface: true,
     };
-    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;

@@ -70,7 +70,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     require_free_surface_scheme("hydrostatic_tank", p)?;
     let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
     let c0 = constants.c0;
-    let (kernel, h, scheme) = fluid_scheme(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
     check_wall_layers("hydrostatic_tank", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);
     let x = lattice(0.0, width, 0.0, height, dx);

@@ -76,6 +76,7 @@ pub struct SceneEntry {
 /// Every scene.
 pub const SCENES: &[SceneEntry] = &[
     taylor_green::ENTRY,
+    taylor_green::ENTRY_3D,
     cavity::ENTRY,
     dam_break::ENTRY,
     hydrostatic_tank::ENTRY,
