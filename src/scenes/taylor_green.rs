@@ -49,26 +49,21 @@ const METRICS: &[&str] = &[
 ];
 
 /// The registry entry of the square.
-pub const ENTRY: SceneEntry = SceneEntry {
-    name: "taylor_green",
-    dim: 2,
-    about: "Taylor-Green vortex in a periodic unit square, against the exact solution (CTVF sec. 4.1)",
-    params: params::<2>,
-    build: build::<2>,
-    metrics: METRICS,
-    outputs: 1,
-};
+pub const ENTRY: SceneEntry = entry::<2>(
+    "taylor_green",
+    "Taylor-Green vortex in a periodic unit square, against the exact solution (CTVF sec. 4.1)",
+);
 
 /// The registry entry of the box (3D).
-pub const ENTRY_3D: SceneEntry = SceneEntry {
-    name: "taylor_green_3d",
-    dim: 3,
-    about: "The Taylor-Green vortex in a periodic box nz layers deep, uniform along z: the 3D solver against the same exact solution",
-    params: params::<3>,
-    build: build::<3>,
-    metrics: METRICS,
-    outputs: 1,
-};
+pub const ENTRY_3D: SceneEntry = entry::<3>(
+    "taylor_green_3d",
+    "The Taylor-Green vortex in a periodic box nz layers deep, uniform along z: the 3D solver against the same exact solution",
+);
+
+/// The scene in `D` dimensions: one source, the dimension a parameter.
+const fn entry<const D: usize>(name: &'static str, about: &'static str) -> SceneEntry {
+    SceneEntry { name, dim: D, about, params: params::<D>, build: build::<D>, metrics: METRICS, outputs: 1 }
+}
 
 fn params<const D: usize>() -> Vec<Spec> {
     let mut v = vec![
@@ -106,7 +101,8 @@ pub fn exact<const D: usize>(x: &Vector<D>, t: f64, re: f64) -> (Vector<D>, f64)
 
 struct TaylorGreen<const D: usize> {
     sim: Simulation<D>,
-    nx: usize,
+    /// The domain, for the plan.
+    setting: String,
     re: f64,
     l1: L1History,
 }
@@ -145,7 +141,11 @@ impl L1History {
 
 fn build<const D: usize>(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let sim = simulation::<D>(p)?;
-    Ok(Box::new(TaylorGreen { sim, nx: p.int("nx") as usize, re: p.float("re"), l1: L1History::default() }))
+    let setting = match D {
+        2 => "periodic unit square".to_string(),
+        _ => format!("periodic box, {} layers deep", p.int("nz")),
+    };
+    Ok(Box::new(TaylorGreen { sim, setting, re: p.float("re"), l1: L1History::default() }))
 }
 
 /// The simulation the scene runs in `D` dimensions, for benchmarks and tests that drive
@@ -269,11 +269,7 @@ impl<const D: usize> TaylorGreen<D> {
 impl<const D: usize> SceneRun for TaylorGreen<D> {
     forward_to_sim!();
     fn plan(&self) -> String {
-        let setting = match D {
-            2 => "periodic unit square".to_string(),
-            _ => format!("periodic box, {} layers deep", self.sim.fluid().len() / self.nx.pow(2)),
-        };
-        plan(&self.sim, &setting)
+        plan(&self.sim, &self.setting)
     }
     fn save_state(&self) -> serde_json::Value {
         serde_json::json!({ "sim": &self.sim.state, "l1": self.l1 })

@@ -977,13 +977,12 @@ mod tests {
             .iter()
             .zip(&two)
             .all(|(a, b)| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits()));
-        let k = kernel.scaled(dx);
         let mut largest = 0.0f64;
         for (i, a) in one.iter().enumerate() {
+            // The term of eq. (37) over the whole list.
             let mut d = Vector::<2>::zeros();
-            nl.for_each(i, &fluid.x, |j, xij, r2, _| {
-                let r = r2.sqrt();
-                d += xij * (fluid.m[j] / fluid.rho[j] * shifting::ipst_factor(k.w(r), r));
+            nl.for_each(i, &fluid.x, |j, xij, r2, &(w, f)| {
+                d += shifting::ipst_displacement(fluid.m[j] / fluid.rho[j], &Pair::new(xij, r2, dx, w, f));
             });
             // eq. (41) of one move of eq. (37)
             let direct = d * (u_max * dt) * (2.0 / (dt * dt));
