@@ -39,6 +39,15 @@ fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
         ("taylor_green", &["nx"], &["nx"]),
         // A box too small for the kernel support is a parameter error, not a panic.
         ("taylor_green", &["nx=4"], &["nx"]),
+        // A support that does not reach the nearest particle (3 h or 2 h <= dx).
+        ("taylor_green", &["hdx=0.3"], &["hdx", "0.3", "hdx > 0.3333"]),
+        ("taylor_green", &["kernel=cubic_spline", "hdx=0.5"], &["hdx", "0.5"]),
+        // A resolution that cannot run is refused before any particle is made: more
+        // particles than 32-bit indices hold, or (3.6e9 particles, some 7 TB) more memory
+        // than the machine has.
+        ("taylor_green", &["nx=100000"], &["nx", "100000", "indexes"]),
+        ("taylor_green", &["nx=60000"], &["nx", "60000", "GiB"]),
+        ("dam_break", &["dx=0.00001"], &["dx", "0.00001"]),
         ("taylor_green_3d", &["nz=4"], &["nz", "4"]),
         ("taylor_green_3d", &["nz=0"], &["nz", "0"]),
         ("no_such_scene", &[], &["no_such_scene"]),

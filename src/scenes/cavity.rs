@@ -15,8 +15,8 @@
 //! `centerline_v.csv` (x, v), 101 points each.
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params,
-    shepard, snapshot_bodies, wall_density, wall_from, wall_params, FluidConstants,
+    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim,
+    scheme_params, shepard, snapshot_bodies, wall_density, wall_from, wall_params, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -97,8 +97,9 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
+    check_size("cavity", "nx", nx, ((nx + 2 * LAYERS) as f64).powi(2))?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
-    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>("cavity", p, &constants)?;
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };

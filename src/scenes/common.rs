@@ -153,10 +153,25 @@ pub fn require_free_surface_scheme(scene: &str, p: &Params) -> Result<(), String
 }
 
 /// The kernel (normalised in `D` dimensions), smoothing length and scheme the parameters
-/// ask for.
-pub fn fluid_scheme<const D: usize>(p: &Params, c: &FluidConstants) -> (Kernel, f64, FluidScheme) {
-    let h = p.float("hdx") * c.dx;
+/// ask for. A support that does not reach the nearest particle (`support * hdx <= 1`) is
+/// refused: the particles would have no neighbours, and Sun's shifting divides by W(dx) = 0.
+pub fn fluid_scheme<const D: usize>(
+    scene: &str,
+    p: &Params,
+    c: &FluidConstants,
+) -> Result<(Kernel, f64, FluidScheme), String> {
+    let hdx = p.float("hdx");
+    let h = hdx * c.dx;
     let kernel = Kernel::new(KernelKind::from_name(p.str("kernel")).expect("checked choice"), D);
+    if kernel.support() * hdx <= 1.0 {
+        return Err(format!(
+            "scene `{scene}`: `hdx` = {hdx}: the {} support ({} h = {:.3} dx) does not reach the nearest particle at dx; use hdx > {:.4}",
+            p.str("kernel"),
+            kernel.support(),
+            kernel.support() * hdx,
+            1.0 / kernel.support()
+        ));
+    }
     let all = p.str("corrections") == "all";
     let corrections = Corrections {
         continuity: switch(p, "corr_continuity", all),
@@ -187,7 +202,48 @@ pub fn fluid_scheme<const D: usize>(p: &Params, c: &FluidConstants) -> (Kernel, 
         }),
     };
     let scheme = SchemeName::from_name(p.str("scheme")).expect("checked choice").fluid_scheme(&settings);
-    (kernel, h, scheme)
+    Ok((kernel, h, scheme))
+}
+
+/// Bytes a particle takes at most, with its neighbour list and every scheme's work arrays:
+/// `sphrepro bench` measures 860-1940 (the most at nx = 50, where fixed costs weigh).
+const BYTES_PER_PARTICLE: f64 = 2048.0;
+
+/// Refuses a resolution (parameter `key` = `value`) whose `particles` could not run: more
+/// than the neighbour lists' 32-bit indices hold, or more memory than this machine has
+/// (`MemTotal` of /proc/meminfo, where there is one). Called before any particle is made,
+/// so that a mistyped resolution is a parameter error, not minutes of allocation ending in
+/// an abort.
+pub fn check_size(
+    scene: &str,
+    key: &str,
+    value: impl std::fmt::Display,
+    particles: f64,
+) -> Result<(), String> {
+    let refuse =
+        |why: String| Err(format!("scene `{scene}`: `{key}` = {value}: {particles:.3e} particles {why}"));
+    if particles > u32::MAX as f64 {
+        return refuse(format!("are more than the {} a neighbour list indexes", u32::MAX));
+    }
+    let need = particles * BYTES_PER_PARTICLE;
+    match total_memory() {
+        Some(have) if need > have => refuse(format!(
+            "need about {:.1} GiB, more than this machine's {:.1} GiB",
+            need / GIB,
+            have / GIB
+        )),
+        _ => Ok(()),
+    }
+}
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// The machine's physical memory in bytes, if the system says (Linux).
+fn total_memory() -> Option<f64> {
+    let info = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib * 1024.0)
 }
 
 /// A `D`-vector as the three components ParaView reads (zeros beyond `D`).

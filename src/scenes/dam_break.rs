@@ -16,7 +16,7 @@
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
+    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
     require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
     wall_params, FluidConstants,
 };
@@ -108,9 +108,11 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         return bad("dx", "the column must be at least 4 particles wide and high".into());
     }
     require_free_surface_scheme("dam_break", p)?;
+    let walls = (tw + 2.0 * th) / dx * LAYERS as f64;
+    check_size("dam_break", "dx", dx, (l / dx) * (hc / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
     let (c0, u_ref) = (constants.c0, constants.u_ref);
-    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>("dam_break", p, &constants)?;
     check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);
     let fluid =

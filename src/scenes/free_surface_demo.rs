@@ -7,8 +7,8 @@
 //! (outer-layer particles not found).
 
 use super::common::{
-    fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim, scheme_params,
-    snapshot_bodies, wall_from, FluidConstants,
+    check_size, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim,
+    scheme_params, snapshot_bodies, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -60,6 +60,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     if dx > 0.1 {
         return Err(format!("scene `free_surface_demo`: `dx` = {dx} leaves too few particles (at most 0.1)"));
     }
+    // The largest shape's lattice (2 x 2 around the ring) and a tank's walls.
+    check_size("free_surface_demo", "dx", dx, 4.0 / (dx * dx) + 30.0 / dx)?;
     let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, OuterLayer) = match p.str("shape") {
         "ring" => (
             lattice(-1.0, 1.0, -1.0, 1.0, dx)
@@ -92,7 +94,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         gravity: [0.0; 3],
         free_surface: true,
     };
-    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>("free_surface_demo", p, &constants)?;
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;

@@ -10,7 +10,7 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
+    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
     require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
     wall_params, FluidConstants,
 };
@@ -68,9 +68,11 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         }
     }
     require_free_surface_scheme("hydrostatic_tank", p)?;
+    let walls = (width + 3.0 * height) / dx * LAYERS as f64;
+    check_size("hydrostatic_tank", "dx", dx, (width / dx) * (height / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
     let c0 = constants.c0;
-    let (kernel, h, scheme) = fluid_scheme::<2>(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<2>("hydrostatic_tank", p, &constants)?;
     check_wall_layers("hydrostatic_tank", p, &kernel, h, dx, LAYERS)?;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);
     let x = lattice(0.0, width, 0.0, height, dx);

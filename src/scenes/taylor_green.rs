@@ -20,7 +20,8 @@
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
 use super::common::{
-    fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies, FluidConstants,
+    check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies,
+    FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -155,11 +156,12 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
+    let nz = if D == 3 { p.int("nz") as usize } else { 1 };
+    check_size(scene, "nx", nx, (nx as f64).powi(2) * nz as f64)?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
-    let (kernel, h, scheme) = fluid_scheme::<D>(p, &constants);
+    let (kernel, h, scheme) = fluid_scheme::<D>(scene, p, &constants)?;
     // Layers along a third axis: the box must hold two kernel supports for its periodic
     // images to be distinct.
-    let nz = if D == 3 { p.int("nz") as usize } else { 1 };
     let depth = nz as f64 * dx;
     if D == 3 && depth < 2.0 * kernel.support() * h {
         return Err(format!(
