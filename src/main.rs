@@ -108,6 +108,10 @@ enum Command {
         /// Preset.
         #[arg(long, default_value = "quick")]
         preset: String,
+        /// List every stale folder (results of earlier inputs) with what changed, not only
+        /// their count.
+        #[arg(long)]
+        stale: bool,
         #[command(flatten)]
         dirs: DirArgs,
     },
@@ -244,7 +248,9 @@ fn run(cli: Cli) -> ExitCode {
             &args.options(),
             &RunFlags { plot_only: args.plot_only, manuscript: true },
         )),
-        Command::Status { preset, dirs } => ExitCode::from(commands::status(&dirs.dirs(), &preset)),
+        Command::Status { preset, stale, dirs } => {
+            ExitCode::from(commands::status(&dirs.dirs(), &preset, stale))
+        }
         Command::Check { preset, dirs } => ExitCode::from(commands::check(&dirs.dirs(), &preset)),
         Command::Simulate {
             scene,

@@ -116,9 +116,12 @@ fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
     assert_eq!(started("a"), before[0]);
     assert_eq!(started("c"), before[2]);
     assert_eq!(env.summary("b")["params"]["nx"], 15);
-    // The old folder of b is reported as stale, not deleted.
+    // The old folder of b is reported as stale, not deleted; `--stale` lists it with what
+    // changed.
     let o = env.run(&["status"]);
     assert!(text(&o).contains("1 stale folder(s)"), "{}", text(&o));
+    let o = env.run(&["status", "--stale"]);
+    assert!(text(&o).contains("case b now has nx 14 -> 15; kept, not deleted"), "{}", text(&o));
 
     // check: within bounds passes; a breached bound names problem, case, metric, value, bound.
     let o = env.run(&["check"]);
@@ -269,4 +272,43 @@ fn an_unwritable_output_folder_is_reported_with_its_path() {
     let t = text(&o);
     assert!(!o.status.success(), "{t}");
     assert!(t.contains("afile/out") && !t.contains("panicked"), "{t}");
+}
+
+/// `status` for one preset does not call the other preset's current results stale; a
+/// preset edited afterwards leaves a stale folder, counted and, with `--stale`, listed.
+#[test]
+fn status_keeps_other_presets_apart_from_stale_folders() {
+    let toml = |quick_tf: f64| {
+        format!(
+            r#"title = "tiny"
+scene = "taylor_green"
+[params]
+tf = "$tf"
+[presets.quick]
+tf = {quick_tf}
+[presets.paper]
+tf = 0.03
+[[cases]]
+name = "a"
+params = {{ nx = 12 }}
+"#
+        )
+    };
+    let env = Env::new(&toml(0.02));
+    assert!(env.run(&["run", "tiny"]).status.success());
+    let o = env.run(&["status", "--preset", "paper"]);
+    let t = text(&o);
+    assert!(!o.status.success(), "paper is not done: {t}");
+    assert!(t.contains("1 folder(s) with the results of the problem's other preset(s)"), "{t}");
+    assert!(t.contains("0 done, 0 failed, 1 missing, 0 stale folder(s)"), "{t}");
+    std::fs::write(env.root.join("problems/tiny.toml"), toml(0.025)).unwrap();
+    // Described against the case of the preset asked about.
+    for (preset, now) in [("paper", "0.03"), ("quick", "0.025")] {
+        let o = env.run(&["status", "--preset", preset, "--stale"]);
+        let t = text(&o);
+        assert!(
+            t.contains("1 stale folder(s)") && t.contains(&format!("case a now has tf 0.02 -> {now}")),
+            "{t}"
+        );
+    }
 }

@@ -83,6 +83,16 @@ impl CaseRecord {
 
     /// What differs between `old` (a record found on disk) and this one, in words.
     pub fn changes_from(&self, old: &CaseRecord) -> String {
+        let out = self.changes(old);
+        if out.is_empty() {
+            "unchanged inputs".into()
+        } else {
+            out.join(", ")
+        }
+    }
+
+    /// The inputs that differ from `old`, one entry each.
+    pub fn changes(&self, old: &CaseRecord) -> Vec<String> {
         let mut out = Vec::new();
         if old.scene != self.scene {
             out.push(format!("scene {} -> {}", old.scene, self.scene));
@@ -100,11 +110,7 @@ impl CaseRecord {
                 out.push(format!("{k} {} -> {}", show(a), show(b)));
             }
         }
-        if out.is_empty() {
-            "unchanged inputs".into()
-        } else {
-            out.join(", ")
-        }
+        out
     }
 }
 
@@ -158,10 +164,12 @@ impl Entry {
         matches!(self.state(), State::Done(_))
     }
 
-    /// If another folder holds this case name with another key, what changed.
+    /// If other folders hold this case name with other keys, what changed from the nearest
+    /// of them (the fewest changes, then the first by name, so that the answer does not
+    /// depend on the order the system lists the folder in).
     fn previous_change(&self) -> Option<String> {
         let parent = self.dir.parent()?;
-        let mut found = None;
+        let mut found: Vec<(usize, String, String)> = Vec::new();
         for e in std::fs::read_dir(parent).ok()?.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
             let Some((case, _)) = name.rsplit_once('-') else {
@@ -171,10 +179,10 @@ impl Entry {
                 continue;
             }
             if let Some(old) = read_record(&e.path()) {
-                found = Some(self.record.changes_from(&old));
+                found.push((self.record.changes(&old).len(), name, self.record.changes_from(&old)));
             }
         }
-        found
+        found.into_iter().min_by(|a, b| (a.0, &a.1).cmp(&(b.0, &b.1))).map(|f| f.2)
     }
 
     /// Writes `case.json` (creating the folder).

@@ -100,7 +100,11 @@ pub struct StatusCounts {
 }
 
 /// Prints the state of every case of `problems` (and the stale folders) to stdout.
-pub fn status(output: &Path, problems: &[Problem]) -> StatusCounts {
+///
+/// Folders that hold the current results of another preset of the problem are counted,
+/// not listed; folders of earlier inputs (stale) are listed with `list_stale`, otherwise
+/// counted.
+pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCounts {
     let mut n = StatusCounts::default();
     for p in problems {
         println!("{} ({}, preset {}):", p.name, p.title, p.preset);
@@ -131,13 +135,46 @@ pub fn status(output: &Path, problems: &[Problem]) -> StatusCounts {
                 }
             );
         }
-        let live: Vec<_> = entries.iter().map(|e| e.dir.clone()).collect();
-        for s in cache::stale_folders(output, &p.name, &live) {
-            n.stale_folders += 1;
-            let why = cache::read_record(&s)
-                .map(|r| match entries.iter().find(|e| e.record.name == r.name) {
-                    Some(e) => format!("case {} now has {}", r.name, e.record.changes_from(&r)),
-                    None => format!("case {} is no longer in the problem file", r.name),
+        // The current cases of every preset: another preset's results are not stale.
+        let n_this = entries.len();
+        let mut current = entries;
+        let mut other_presets = 0;
+        for other in p.presets.iter().filter(|o| **o != p.preset) {
+            // The file parsed for `p.preset`, so it parses for its other presets too.
+            if let Ok(q) = super::registry::load(&p.path, other) {
+                for e in cache::entries(output, &q) {
+                    if e.dir.is_dir() && !current.iter().any(|c| c.dir == e.dir) {
+                        other_presets += 1;
+                    }
+                    current.push(e);
+                }
+            }
+        }
+        let live: Vec<_> = current.iter().map(|e| e.dir.clone()).collect();
+        if other_presets > 0 {
+            println!("  {other_presets} folder(s) with the results of the problem's other preset(s)");
+        }
+        let stale = cache::stale_folders(output, &p.name, &live);
+        n.stale_folders += stale.len();
+        if !list_stale && !stale.is_empty() {
+            println!(
+                "  {} stale folder(s): results of earlier inputs, kept, not deleted (`status --stale` lists them)",
+                stale.len()
+            );
+        }
+        for s in if list_stale { &stale[..] } else { &[] } {
+            // Against the case of that name in this preset, else in the nearest other one.
+            let why = cache::read_record(s)
+                .map(|r| {
+                    let named = |e: &&cache::Entry| e.record.name == r.name;
+                    let this = current[..n_this].iter().find(named);
+                    let nearest = this.or_else(|| {
+                        current[n_this..].iter().filter(named).min_by_key(|e| e.record.changes(&r).len())
+                    });
+                    match nearest {
+                        Some(e) => format!("case {} now has {}", r.name, e.record.changes_from(&r)),
+                        None => format!("case {} is no longer in the problem file", r.name),
+                    }
                 })
                 .unwrap_or_else(|| "no case.json".into());
             println!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());

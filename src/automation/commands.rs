@@ -203,10 +203,10 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
 }
 
 /// `status`: every case's state and the stale folders. Exits 1 if any case is not done.
-pub fn status(dirs: &Dirs, preset: &str) -> u8 {
+pub fn status(dirs: &Dirs, preset: &str, list_stale: bool) -> u8 {
     match load(dirs, preset, &[]) {
         Ok(ps) => {
-            let n = check::status(&dirs.output, &ps);
+            let n = check::status(&dirs.output, &ps, list_stale);
             if n.failed + n.missing == 0 {
                 OK
             } else {

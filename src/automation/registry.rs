@@ -356,6 +356,8 @@ pub struct Problem {
     pub scene: &'static SceneEntry,
     /// Preset the cases were expanded for.
     pub preset: String,
+    /// Every preset the file defines (this one among them).
+    pub presets: Vec<String>,
     /// Cases of this preset.
     pub cases: Vec<Case>,
     /// Figures.
@@ -969,6 +971,7 @@ fn expand(
         description: file.description.clone(),
         scene,
         preset: preset.to_string(),
+        presets: file.presets.keys().cloned().collect(),
         cases,
         figures,
         tables,
