@@ -99,6 +99,13 @@ pub struct StatusCounts {
     pub stale_folders: usize,
 }
 
+/// The simulated and end time a running case last wrote to its `progress` file.
+fn progress(dir: &Path) -> Option<(f64, f64)> {
+    let s = std::fs::read_to_string(dir.join("progress")).ok()?;
+    let mut v = s.split_whitespace().map(|x| x.parse::<f64>().ok());
+    Some((v.next()??, v.next()??))
+}
+
 /// Prints the state of every case of `problems` (and the stale folders) to stdout.
 ///
 /// Folders that hold the current results of another preset of the problem are counted,
@@ -129,6 +136,11 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                 e.case.name,
                 match &st {
                     State::Done(_) => format!("  ({})", state_word(&st)),
+                    State::Failed(_) if running => format!(
+                        "  ({}log {})",
+                        progress(&e.dir).map(|(t, tf)| format!("t = {t:.3} of {tf} s; ")).unwrap_or_default(),
+                        e.dir.join("run.log").display()
+                    ),
                     State::Failed(r) => format!("  ({r}; log {})", e.dir.join("run.log").display()),
                     State::Missing(Some(c)) => format!("  (inputs changed: {c})"),
                     State::Missing(None) => String::new(),
