@@ -97,7 +97,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
-    check_size("cavity", "nx", nx, ((nx + 2 * LAYERS) as f64).powi(2))?;
+    check_size::<2>("cavity", "nx", nx, ((nx + 2 * LAYERS) as f64).powi(2))?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme::<2>("cavity", p, &constants)?;
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;

@@ -205,16 +205,24 @@ pub fn fluid_scheme<const D: usize>(
     Ok((kernel, h, scheme))
 }
 
-/// Bytes a particle takes at most, with its neighbour list and every scheme's work arrays:
-/// `sphrepro bench` measures 860-1940 (the most at nx = 50, where fixed costs weigh).
-const BYTES_PER_PARTICLE: f64 = 2048.0;
+/// Bytes a particle takes at most in `D` dimensions, with its neighbour list and every
+/// scheme's work arrays: in 2D `sphrepro bench` measures 860-1940 (the most at nx = 50, where
+/// fixed costs weigh); in 3D, with four times the neighbours, the peak resident size of a
+/// 40x40x8 Taylor-Green run is 3.5 kB a particle with SPST and 3.8 kB with IPST.
+const fn bytes_per_particle(d: usize) -> f64 {
+    if d < 3 {
+        2048.0
+    } else {
+        4096.0
+    }
+}
 
 /// Refuses a resolution (parameter `key` = `value`) whose `particles` could not run: more
 /// than the neighbour lists' 32-bit indices hold, or more memory than this machine has
 /// (`MemTotal` of /proc/meminfo, where there is one). Called before any particle is made,
 /// so that a mistyped resolution is a parameter error, not minutes of allocation ending in
 /// an abort.
-pub fn check_size(
+pub fn check_size<const D: usize>(
     scene: &str,
     key: &str,
     value: impl std::fmt::Display,
@@ -225,7 +233,7 @@ pub fn check_size(
     if particles > u32::MAX as f64 {
         return refuse(format!("are more than the {} a neighbour list indexes", u32::MAX));
     }
-    let need = particles * BYTES_PER_PARTICLE;
+    let need = particles * bytes_per_particle(D);
     match total_memory() {
         Some(have) if need > have => refuse(format!(
             "need about {:.1} GiB, more than this machine's {:.1} GiB",

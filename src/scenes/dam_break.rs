@@ -109,7 +109,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     }
     require_free_surface_scheme("dam_break", p)?;
     let walls = (tw + 2.0 * th) / dx * LAYERS as f64;
-    check_size("dam_break", "dx", dx, (l / dx) * (hc / dx) + walls)?;
+    check_size::<2>("dam_break", "dx", dx, (l / dx) * (hc / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
     let (c0, u_ref) = (constants.c0, constants.u_ref);
     let (kernel, h, scheme) = fluid_scheme::<2>("dam_break", p, &constants)?;

@@ -61,7 +61,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         return Err(format!("scene `free_surface_demo`: `dx` = {dx} leaves too few particles (at most 0.1)"));
     }
     // The largest shape's lattice (2 x 2 around the ring) and a tank's walls.
-    check_size("free_surface_demo", "dx", dx, 4.0 / (dx * dx) + 30.0 / dx)?;
+    check_size::<2>("free_surface_demo", "dx", dx, 4.0 / (dx * dx) + 30.0 / dx)?;
     let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, OuterLayer) = match p.str("shape") {
         "ring" => (
             lattice(-1.0, 1.0, -1.0, 1.0, dx)

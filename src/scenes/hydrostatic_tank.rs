@@ -69,7 +69,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     }
     require_free_surface_scheme("hydrostatic_tank", p)?;
     let walls = (width + 3.0 * height) / dx * LAYERS as f64;
-    check_size("hydrostatic_tank", "dx", dx, (width / dx) * (height / dx) + walls)?;
+    check_size::<2>("hydrostatic_tank", "dx", dx, (width / dx) * (height / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
     let c0 = constants.c0;
     let (kernel, h, scheme) = fluid_scheme::<2>("hydrostatic_tank", p, &constants)?;

@@ -157,7 +157,7 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
     let re = p.float("re");
     let dx = L / nx as f64;
     let nz = if D == 3 { p.int("nz") as usize } else { 1 };
-    check_size(scene, "nx", nx, (nx as f64).powi(2) * nz as f64)?;
+    check_size::<D>(scene, "nx", nx, (nx as f64).powi(2) * nz as f64)?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme::<D>(scene, p, &constants)?;
     // Layers along a third axis: the box must hold two kernel supports for its periodic
