@@ -234,6 +234,8 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
         ("duplicate case", "name = \"b\"", "name = \"a-nx12\"", "two cases"),
         ("missing case", "cases = [\"a-*\"]", "cases = [\"zz\"]", "zz"),
         ("missing metric", "metric = \"l1_velocity_final\"", "metric = \"l7\"", "l7"),
+        // Valid alone, refused by the scene before anything runs (named by case, not line).
+        ("support reaching no neighbour", "params = { nx = 14 }", "params = { nx = 14, hdx = 0.3 }", "`hdx` = 0.3"),
     ];
     let ok = Env::new(VALID);
     assert!(ok.run(&["run", "tiny", "--dry-run"]).status.success());
@@ -251,7 +253,8 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
             t.contains(&format!("tiny.toml:{line}"))
                 || *what == "missing case"
                 || *what == "missing metric"
-                || *what == "duplicate case",
+                || *what == "duplicate case"
+                || *what == "support reaching no neighbour",
             "{what}: no line {line} in: {t}"
         );
         assert!(t.contains("tiny.toml:"), "{what}: no file in {t}");

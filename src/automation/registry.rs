@@ -494,10 +494,18 @@ pub fn parse_with(
             out = Some(p);
         }
     }
-    out.ok_or_else(|| {
+    let problem = out.ok_or_else(|| {
         let known: Vec<_> = file.presets.keys().cloned().collect();
         format!("{}: no preset `{preset}`; this problem has: {}", path.display(), known.join(", "))
-    })
+    })?;
+    // What the scene would refuse at build time (a support that reaches no neighbour, a
+    // resolution this machine cannot hold, ...), found before anything runs; for the preset
+    // asked for only, since the others may be meant for a larger machine.
+    for c in &problem.cases {
+        (scene.check)(&c.params)
+            .map_err(|e| format!("{}: case `{}` (preset {preset}): {e}", path.display(), c.name))?;
+    }
+    Ok(problem)
 }
 
 fn valid_name(s: &str) -> bool {

@@ -295,9 +295,20 @@ fn run_one(
             secs,
             serde_json::to_value(s).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
         ),
-        State::Failed(r) => Outcome::Failed(format!("{r} (exit status {code})")),
-        State::Missing(_) => Outcome::Failed(format!("no result (exit status {code})")),
+        // `simulate` exits 2 on bad input, having written its one-line error and nothing else.
+        State::Failed(_) if code.code() == Some(2) => {
+            Outcome::Failed(format!("bad input: {}", last_error(&e.dir.join("run.log"))))
+        }
+        State::Failed(r) => Outcome::Failed(format!("{r} ({code})")),
+        State::Missing(_) => Outcome::Failed(format!("no result ({code})")),
     }
+}
+
+/// The last `error: ...` line of a case's log, without the prefix.
+fn last_error(log: &std::path::Path) -> String {
+    let text = std::fs::read_to_string(log).unwrap_or_default();
+    let line = text.lines().rev().find_map(|l| l.strip_prefix("error: "));
+    line.unwrap_or("see the log").to_string()
 }
 
 fn short(s: &str, n: usize) -> String {

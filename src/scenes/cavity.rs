@@ -21,8 +21,10 @@ use super::common::{
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
+use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -42,6 +44,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     about: "Lid-driven cavity against Ghia et al. 1982 (CTVF sec. 4.2)",
     params,
     build,
+    check: |p| setup(p).map(drop),
     metrics: &[
         "ghia_u_rms",
         "ghia_u_max",
@@ -93,14 +96,21 @@ struct Cavity {
     min_density: f64,
 }
 
-fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+/// The spacing, kernel, smoothing length and scheme, once every parameter check that needs
+/// no particle has passed.
+fn setup(p: &Params) -> Result<(f64, Kernel, f64, FluidScheme), String> {
     let nx = p.int("nx") as usize;
-    let re = p.float("re");
     let dx = L / nx as f64;
     check_size::<2>("cavity", "nx", nx, ((nx + 2 * LAYERS) as f64).powi(2))?;
-    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
+    let constants = FluidConstants::internal_flow(RHO0, C0, U, L, p.float("re"), dx);
     let (kernel, h, scheme) = fluid_scheme::<2>("cavity", p, &constants)?;
     check_wall_layers("cavity", p, &kernel, h, dx, LAYERS)?;
+    Ok((dx, kernel, h, scheme))
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let (dx, kernel, h, scheme) = setup(p)?;
+    let re = p.float("re");
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
     let wall =

@@ -24,8 +24,10 @@ use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
+use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -42,6 +44,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     about: "Dam break in a 4 m tank against Koshizuka & Oka 1996 (CTVF sec. 4.3)",
     params,
     build,
+    check: |p| setup(p).map(drop),
     metrics: &["toe_rms", "particles_lost", "max_penetration"],
     outputs: 0,
 };
@@ -94,7 +97,9 @@ struct DamBreak {
     toe: Vec<(f64, f64)>,
 }
 
-fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+/// The constants, kernel, smoothing length and scheme, once every parameter check that
+/// needs no particle has passed.
+fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
     let (dx, l, hc) = (p.float("dx"), p.float("column_width"), p.float("column_height"));
     let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let bad = |key: &str, why: String| Err(format!("scene `dam_break`: `{key}` = {}: {why}", p.float(key)));
@@ -111,9 +116,16 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let walls = (tw + 2.0 * th) / dx * LAYERS as f64;
     check_size::<2>("dam_break", "dx", dx, (l / dx) * (hc / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
-    let (c0, u_ref) = (constants.c0, constants.u_ref);
     let (kernel, h, scheme) = fluid_scheme::<2>("dam_break", p, &constants)?;
     check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
+    Ok((constants, kernel, h, scheme))
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let (dx, l, hc) = (p.float("dx"), p.float("column_width"), p.float("column_height"));
+    let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
+    let (constants, kernel, h, scheme) = setup(p)?;
+    let (c0, u_ref) = (constants.c0, constants.u_ref);
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);
     let fluid =
         fluid_at_rest(lattice(0.0, l, 0.0, hc, dx), dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;

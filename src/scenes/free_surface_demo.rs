@@ -13,10 +13,12 @@ use super::common::{
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::scheme::DensityModel;
+use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -30,6 +32,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     about: "Free-surface particles and normals on a ring, a patch on a wall and a column (CTVF sec. 3.4)",
     params,
     build,
+    check: |p| setup(p).map(drop),
     metrics: &["surface_particles", "interior_surface_particles", "outer_layer_missed"],
     outputs: 0,
 };
@@ -55,13 +58,32 @@ struct Demo {
     outer: Vec<bool>,
 }
 
-fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+/// The kernel, smoothing length and scheme, once every parameter check that needs no
+/// particle has passed.
+fn setup(p: &Params) -> Result<(Kernel, f64, FluidScheme), String> {
     let dx = p.float("dx");
     if dx > 0.1 {
         return Err(format!("scene `free_surface_demo`: `dx` = {dx} leaves too few particles (at most 0.1)"));
     }
     // The largest shape's lattice (2 x 2 around the ring) and a tank's walls.
     check_size::<2>("free_surface_demo", "dx", dx, 4.0 / (dx * dx) + 30.0 / dx)?;
+    let constants = FluidConstants {
+        rho0: RHO0,
+        c0: 10.0,
+        u_ref: 1.0,
+        dx,
+        nu: None,
+        alpha: None,
+        density: DensityModel::Continuity,
+        gravity: [0.0; 3],
+        free_surface: true,
+    };
+    fluid_scheme::<2>("free_surface_demo", p, &constants)
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let dx = p.float("dx");
+    let (kernel, h, scheme) = setup(p)?;
     let (x, walls, outer): (Vec<Vector<2>>, Vec<(Vector<2>, Vector<2>)>, OuterLayer) = match p.str("shape") {
         "ring" => (
             lattice(-1.0, 1.0, -1.0, 1.0, dx)
@@ -83,18 +105,6 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         ),
     };
     let outer: Vec<bool> = x.iter().map(outer).collect();
-    let constants = FluidConstants {
-        rho0: RHO0,
-        c0: 10.0,
-        u_ref: 1.0,
-        dx,
-        nu: None,
-        alpha: None,
-        density: DensityModel::Continuity,
-        gravity: [0.0; 3],
-        free_surface: true,
-    };
-    let (kernel, h, scheme) = fluid_scheme::<2>("free_surface_demo", p, &constants)?;
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;

@@ -17,8 +17,10 @@ use super::common::{
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
+use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -34,6 +36,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     about: "Fluid at rest in a tank under gravity: wall pressure and spurious currents",
     params,
     build,
+    check: |p| setup(p).map(drop),
     metrics: &["pressure_rel_error", "max_speed", "particles_outside"],
     outputs: 0,
 };
@@ -58,7 +61,9 @@ struct Tank {
     width: f64,
 }
 
-fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+/// The constants, kernel, smoothing length and scheme, once every parameter check that
+/// needs no particle has passed.
+fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
     let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
     for (key, len) in [("height", height), ("width", width)] {
         if len < 4.0 * dx {
@@ -71,9 +76,15 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let walls = (width + 3.0 * height) / dx * LAYERS as f64;
     check_size::<2>("hydrostatic_tank", "dx", dx, (width / dx) * (height / dx) + walls)?;
     let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
-    let c0 = constants.c0;
     let (kernel, h, scheme) = fluid_scheme::<2>("hydrostatic_tank", p, &constants)?;
     check_wall_layers("hydrostatic_tank", p, &kernel, h, dx, LAYERS)?;
+    Ok((constants, kernel, h, scheme))
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
+    let (constants, kernel, h, scheme) = setup(p)?;
+    let c0 = constants.c0;
     let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);
     let x = lattice(0.0, width, 0.0, height, dx);
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;

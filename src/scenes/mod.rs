@@ -65,6 +65,9 @@ pub struct SceneEntry {
     pub params: fn() -> Vec<Spec>,
     /// Builds the scene; errors name the parameter.
     pub build: fn(&Params) -> Result<Box<dyn SceneRun>, String>,
+    /// The parameter errors `build` would report, found without making a particle (problem
+    /// files are checked with it before anything runs).
+    pub check: fn(&Params) -> Result<(), String>,
     /// Names of the metrics written to `summary.json`.
     pub metrics: &'static [&'static str],
     /// Version of what the scene reports (metrics, time-series columns): raised when one is

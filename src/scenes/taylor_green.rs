@@ -25,10 +25,12 @@ use super::common::{
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
+use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, TimeSettings};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
@@ -63,7 +65,16 @@ pub const ENTRY_3D: SceneEntry = entry::<3>(
 
 /// The scene in `D` dimensions: one source, the dimension a parameter.
 const fn entry<const D: usize>(name: &'static str, about: &'static str) -> SceneEntry {
-    SceneEntry { name, dim: D, about, params: params::<D>, build: build::<D>, metrics: METRICS, outputs: 1 }
+    SceneEntry {
+        name,
+        dim: D,
+        about,
+        params: params::<D>,
+        build: build::<D>,
+        check: |p| setup::<D>(p).map(drop),
+        metrics: METRICS,
+        outputs: 1,
+    }
 }
 
 fn params<const D: usize>() -> Vec<Spec> {
@@ -149,9 +160,21 @@ fn build<const D: usize>(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     Ok(Box::new(TaylorGreen { sim, setting, re: p.float("re"), l1: L1History::default() }))
 }
 
-/// The simulation the scene runs in `D` dimensions, for benchmarks and tests that drive
-/// steps directly.
-pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
+/// What the particles are made from, once every parameter check that needs none of them
+/// has passed.
+struct Setup<const D: usize> {
+    scene: &'static str,
+    nx: usize,
+    nz: usize,
+    dx: f64,
+    re: f64,
+    kernel: Kernel,
+    h: f64,
+    scheme: FluidScheme,
+    domain: Domain<D>,
+}
+
+fn setup<const D: usize>(p: &Params) -> Result<Setup<D>, String> {
     let scene = if D == 3 { ENTRY_3D.name } else { ENTRY.name };
     let nx = p.int("nx") as usize;
     let re = p.float("re");
@@ -169,12 +192,19 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
             2.0 * kernel.support() * h
         ));
     }
+    let domain = Domain::periodic([0.0; D], std::array::from_fn(|k| if k < 2 { L } else { depth }));
+    domain.check_periodic(kernel.support() * h).map_err(|e| format!("scene `{scene}`: {e}"))?;
+    Ok(Setup { scene, nx, nz, dx, re, kernel, h, scheme, domain })
+}
 
+/// The simulation the scene runs in `D` dimensions, for benchmarks and tests that drive
+/// steps directly.
+pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
+    let Setup { scene, nx, nz, dx, re, kernel, h, scheme, domain } = setup::<D>(p)?;
     // Lattice at cell centres, optionally perturbed (seeded), initialised from the exact
     // solution at t = 0 at the perturbed positions.
     let perturb = p.float("perturb");
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(p.int("seed") as u64);
-    let domain = Domain::periodic([0.0; D], std::array::from_fn(|k| if k < 2 { L } else { depth }));
     let mut init = FluidInit::default();
     for k in 0..nz {
         for j in 0..nx {

@@ -134,14 +134,7 @@ impl<const D: usize> Simulation<D> {
     ) -> Result<Self, String> {
         scheme.set_walls(wall.is_some());
         let radius = kernel.support() * fluid.h;
-        for k in 0..D {
-            if domain.periodic[k] && domain.length(k) < 2.0 * radius {
-                return Err(format!(
-                    "periodic box length {} along axis {k} is shorter than two kernel radii ({radius}): increase nx or lower hdx",
-                    domain.length(k)
-                ));
-            }
-        }
+        domain.check_periodic(radius)?;
         let n = fluid.len();
         let rates = FluidRates::new(
             n,

@@ -50,6 +50,21 @@ impl<const D: usize> Domain<D> {
         self.max[k] - self.min[k]
     }
 
+    /// Refuses a periodic axis shorter than two search radii `radius`: a particle's
+    /// periodic images would then be within reach of each other (and [`CellList::new`]
+    /// panics on it).
+    pub fn check_periodic(&self, radius: f64) -> Result<(), String> {
+        for k in 0..D {
+            if self.periodic[k] && self.length(k) < 2.0 * radius {
+                return Err(format!(
+                    "periodic box length {} along axis {k} is shorter than two kernel radii ({radius}): increase nx or lower hdx",
+                    self.length(k)
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// Wraps periodic coordinates into `[min, max)`; bounded axes are left alone.
     #[inline]
     pub fn wrap(&self, x: &mut Vector<D>) {
