@@ -124,3 +124,35 @@ pub fn common_params(tf: f64) -> Vec<Spec> {
         Spec::float("cfl", 0.25, Bound::Positive, "factor of the time-step limits, CTVF eq. (61)"),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `check` refuses what `build` refuses, with the same message, and passes what it builds.
+    #[test]
+    fn check_refuses_what_build_refuses() {
+        let cases: &[(&str, &[&str])] = &[
+            ("taylor_green", &["hdx=0.3"]),
+            ("taylor_green", &["nx=4"]),
+            ("taylor_green", &["nx=100000"]),
+            ("taylor_green_3d", &["nz=4"]),
+            ("cavity", &["kernel=cubic_spline", "hdx=0.4"]),
+            ("dam_break", &["tank_width=0.5"]),
+            ("dam_break", &["scheme=edac"]),
+            ("hydrostatic_tank", &["height=0.01"]),
+            ("free_surface_demo", &["dx=0.2"]),
+        ];
+        for (scene, sets) in cases {
+            let e = find(scene).unwrap();
+            let p = e.params_from_sets(&sets.iter().map(|s| s.to_string()).collect::<Vec<_>>()).unwrap();
+            let checked = (e.check)(&p).expect_err(&format!("{scene} {sets:?} passes check"));
+            let built = (e.build)(&p).err().expect("build refuses it");
+            assert_eq!(checked, built, "{scene} {sets:?}");
+        }
+        for e in SCENES {
+            let p = Params::defaults(&(e.params)());
+            assert!((e.check)(&p).is_ok(), "{}: defaults refused", e.name);
+        }
+    }
+}
