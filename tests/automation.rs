@@ -235,7 +235,12 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
         ("missing case", "cases = [\"a-*\"]", "cases = [\"zz\"]", "zz"),
         ("missing metric", "metric = \"l1_velocity_final\"", "metric = \"l7\"", "l7"),
         // Valid alone, refused by the scene before anything runs (named by case, not line).
-        ("support reaching no neighbour", "params = { nx = 14 }", "params = { nx = 14, hdx = 0.3 }", "`hdx` = 0.3"),
+        (
+            "support reaching no neighbour",
+            "params = { nx = 14 }",
+            "params = { nx = 14, hdx = 0.3 }",
+            "`hdx` = 0.3",
+        ),
     ];
     let ok = Env::new(VALID);
     assert!(ok.run(&["run", "tiny", "--dry-run"]).status.success());
