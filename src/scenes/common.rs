@@ -219,7 +219,7 @@ const fn bytes_per_particle(d: usize) -> f64 {
 
 /// Refuses a resolution (parameter `key` = `value`) whose `particles` could not run: more
 /// than the neighbour lists' 32-bit indices hold, or more memory than this machine has
-/// (`MemTotal` of /proc/meminfo, where there is one). Called before any particle is made,
+/// (see `total_memory`). Called before any particle is made,
 /// so that a mistyped resolution is a parameter error, not minutes of allocation ending in
 /// an abort.
 pub fn check_size<const D: usize>(
@@ -246,12 +246,15 @@ pub fn check_size<const D: usize>(
 
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
-/// The machine's physical memory in bytes, if the system says (Linux).
+/// The memory this process may use in bytes, if the system says (Linux): the machine's
+/// physical memory, or a container's limit (cgroup v2) if lower.
 fn total_memory() -> Option<f64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib * 1024.0)
+    let limit =
+        std::fs::read_to_string("/sys/fs/cgroup/memory.max").ok().and_then(|s| s.trim().parse::<f64>().ok());
+    Some(limit.map_or(kib * 1024.0, |l| l.min(kib * 1024.0)))
 }
 
 /// A `D`-vector as the three components ParaView reads (zeros beyond `D`).
