@@ -219,9 +219,8 @@ const fn bytes_per_particle(d: usize) -> f64 {
 
 /// Refuses a resolution (parameter `key` = `value`) whose `particles` could not run: more
 /// than the neighbour lists' 32-bit indices hold, or more memory than this machine has
-/// (see `total_memory`). Called before any particle is made,
-/// so that a mistyped resolution is a parameter error, not minutes of allocation ending in
-/// an abort.
+/// (see `total_memory`). Called before any particle is made, so that a mistyped resolution
+/// is a parameter error, not minutes of allocation ending in an abort.
 pub fn check_size<const D: usize>(
     scene: &str,
     key: &str,
