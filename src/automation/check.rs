@@ -151,16 +151,12 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
         let n_this = entries.len();
         let mut current = entries;
         let mut other_presets = 0;
-        for other in p.presets.iter().filter(|o| **o != p.preset) {
-            // The file parsed for `p.preset`, so it parses for its other presets too.
-            if let Ok(q) = super::registry::load(&p.path, other) {
-                for e in cache::entries(output, &q) {
-                    if e.dir.is_dir() && !current.iter().any(|c| c.dir == e.dir) {
-                        other_presets += 1;
-                    }
-                    current.push(e);
-                }
+        for e in p.other_presets.iter().flat_map(|(_, cases)| cases).map(|c| cache::Entry::new(output, p, c))
+        {
+            if e.dir.is_dir() && !current.iter().any(|c| c.dir == e.dir) {
+                other_presets += 1;
             }
+            current.push(e);
         }
         let live: Vec<_> = current.iter().map(|e| e.dir.clone()).collect();
         if other_presets > 0 {

@@ -356,8 +356,9 @@ pub struct Problem {
     pub scene: &'static SceneEntry,
     /// Preset the cases were expanded for.
     pub preset: String,
-    /// Every preset the file defines (this one among them).
-    pub presets: Vec<String>,
+    /// The cases each other preset of the file expands to (by preset name), so that their
+    /// results are known for what they are.
+    pub other_presets: Vec<(String, Vec<Case>)>,
     /// Cases of this preset.
     pub cases: Vec<Case>,
     /// Figures.
@@ -487,17 +488,20 @@ pub fn parse_with(
             ));
         }
     }
-    let mut out = None;
+    let (mut out, mut others) = (None, Vec::new());
     for (pname, vars) in &file.presets {
         let p = expand(&loc, &file, scene, &specs, &name, pname, vars.get_ref())?;
         if pname == preset {
             out = Some(p);
+        } else {
+            others.push((pname.clone(), p.cases));
         }
     }
-    let problem = out.ok_or_else(|| {
+    let mut problem = out.ok_or_else(|| {
         let known: Vec<_> = file.presets.keys().cloned().collect();
         format!("{}: no preset `{preset}`; this problem has: {}", path.display(), known.join(", "))
     })?;
+    problem.other_presets = others;
     // What the scene would refuse at build time (a support that reaches no neighbour, a
     // resolution this machine cannot hold, ...), found before anything runs; for the preset
     // asked for only, since the others may be meant for a larger machine.
@@ -979,7 +983,7 @@ fn expand(
         description: file.description.clone(),
         scene,
         preset: preset.to_string(),
-        presets: file.presets.keys().cloned().collect(),
+        other_presets: Vec::new(),
         cases,
         figures,
         tables,
