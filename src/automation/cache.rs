@@ -83,11 +83,15 @@ impl CaseRecord {
 
     /// What differs between `old` (a record found on disk) and this one, in words.
     pub fn changes_from(&self, old: &CaseRecord) -> String {
-        let out = self.changes(old);
-        if out.is_empty() {
+        Self::describe(self.changes(old))
+    }
+
+    /// A list of [`changes`](Self::changes) as one line.
+    fn describe(changes: Vec<String>) -> String {
+        if changes.is_empty() {
             "unchanged inputs".into()
         } else {
-            out.join(", ")
+            changes.join(", ")
         }
     }
 
@@ -169,7 +173,7 @@ impl Entry {
     /// depend on the order the system lists the folder in).
     fn previous_change(&self) -> Option<String> {
         let parent = self.dir.parent()?;
-        let mut found: Vec<(usize, String, String)> = Vec::new();
+        let mut found: Vec<(Vec<String>, String)> = Vec::new();
         for e in std::fs::read_dir(parent).ok()?.flatten() {
             let name = e.file_name().to_string_lossy().into_owned();
             let Some((case, _)) = name.rsplit_once('-') else {
@@ -179,10 +183,11 @@ impl Entry {
                 continue;
             }
             if let Some(old) = read_record(&e.path()) {
-                found.push((self.record.changes(&old).len(), name, self.record.changes_from(&old)));
+                found.push((self.record.changes(&old), name));
             }
         }
-        found.into_iter().min_by(|a, b| (a.0, &a.1).cmp(&(b.0, &b.1))).map(|f| f.2)
+        let nearest = found.into_iter().min_by(|a, b| (a.0.len(), &a.1).cmp(&(b.0.len(), &b.1)))?;
+        Some(CaseRecord::describe(nearest.0))
     }
 
     /// Writes `case.json` (creating the folder).
