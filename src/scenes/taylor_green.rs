@@ -163,7 +163,6 @@ fn build<const D: usize>(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 /// What the particles are made from, once every parameter check that needs none of them
 /// has passed.
 struct Setup<const D: usize> {
-    scene: &'static str,
     nx: usize,
     nz: usize,
     dx: f64,
@@ -174,8 +173,17 @@ struct Setup<const D: usize> {
     domain: Domain<D>,
 }
 
+/// The scene's name in `D` dimensions, for its errors.
+const fn name<const D: usize>() -> &'static str {
+    if D == 3 {
+        ENTRY_3D.name
+    } else {
+        ENTRY.name
+    }
+}
+
 fn setup<const D: usize>(p: &Params) -> Result<Setup<D>, String> {
-    let scene = if D == 3 { ENTRY_3D.name } else { ENTRY.name };
+    let scene = name::<D>();
     let nx = p.int("nx") as usize;
     let re = p.float("re");
     let dx = L / nx as f64;
@@ -183,24 +191,25 @@ fn setup<const D: usize>(p: &Params) -> Result<Setup<D>, String> {
     check_size::<D>(scene, "nx", nx, (nx as f64).powi(2) * nz as f64)?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme::<D>(scene, p, &constants)?;
-    // Layers along a third axis: the box must hold two kernel supports for its periodic
-    // images to be distinct.
     let depth = nz as f64 * dx;
-    if D == 3 && depth < 2.0 * kernel.support() * h {
+    let domain = Domain::periodic([0.0; D], std::array::from_fn(|k| if k < 2 { L } else { depth }));
+    // The box must hold two kernel supports along each axis for its periodic images to be
+    // distinct; along the third, that is a matter of `nz`.
+    let radius = kernel.support() * h;
+    if domain.short_periodic_axis(radius) == Some(2) {
         return Err(format!(
             "scene `{scene}`: `nz` = {nz}: the box ({depth:.4} deep) must be at least two kernel supports ({:.4}) deep",
-            2.0 * kernel.support() * h
+            2.0 * radius
         ));
     }
-    let domain = Domain::periodic([0.0; D], std::array::from_fn(|k| if k < 2 { L } else { depth }));
-    domain.check_periodic(kernel.support() * h).map_err(|e| format!("scene `{scene}`: {e}"))?;
-    Ok(Setup { scene, nx, nz, dx, re, kernel, h, scheme, domain })
+    domain.check_periodic(radius).map_err(|e| format!("scene `{scene}`: {e}"))?;
+    Ok(Setup { nx, nz, dx, re, kernel, h, scheme, domain })
 }
 
 /// The simulation the scene runs in `D` dimensions, for benchmarks and tests that drive
 /// steps directly.
 pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
-    let Setup { scene, nx, nz, dx, re, kernel, h, scheme, domain } = setup::<D>(p)?;
+    let Setup { nx, nz, dx, re, kernel, h, scheme, domain } = setup::<D>(p)?;
     // Lattice at cell centres, optionally perturbed (seeded), initialised from the exact
     // solution at t = 0 at the perturbed positions.
     let perturb = p.float("perturb");
@@ -232,7 +241,8 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
     }
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
     let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
-    Simulation::new(domain, kernel, fluid, None, scheme, time).map_err(|e| format!("scene `{scene}`: {e}"))
+    Simulation::new(domain, kernel, fluid, None, scheme, time)
+        .map_err(|e| format!("scene `{}`: {e}", name::<D>()))
 }
 
 /// Parameters of this scene from `key=value` strings over the defaults.

@@ -50,19 +50,22 @@ impl<const D: usize> Domain<D> {
         self.max[k] - self.min[k]
     }
 
-    /// Refuses a periodic axis shorter than two search radii `radius`: a particle's
-    /// periodic images would then be within reach of each other (and [`CellList::new`]
-    /// panics on it).
+    /// The first periodic axis shorter than two search radii `radius`, if any: a
+    /// particle's periodic images would be within reach of each other along it (and
+    /// [`CellList::new`] panics on it).
+    pub fn short_periodic_axis(&self, radius: f64) -> Option<usize> {
+        (0..D).find(|&k| self.periodic[k] && self.length(k) < 2.0 * radius)
+    }
+
+    /// Refuses a domain with a [`short_periodic_axis`](Self::short_periodic_axis).
     pub fn check_periodic(&self, radius: f64) -> Result<(), String> {
-        for k in 0..D {
-            if self.periodic[k] && self.length(k) < 2.0 * radius {
-                return Err(format!(
-                    "periodic box length {} along axis {k} is shorter than two kernel radii ({radius}): increase nx or lower hdx",
-                    self.length(k)
-                ));
-            }
+        match self.short_periodic_axis(radius) {
+            Some(k) => Err(format!(
+                "periodic box length {} along axis {k} is shorter than two kernel radii ({radius}): increase nx or lower hdx",
+                self.length(k)
+            )),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Wraps periodic coordinates into `[min, max)`; bounded axes are left alone.
