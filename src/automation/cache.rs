@@ -37,6 +37,20 @@ pub fn fingerprint_of_case(scene: &str, params: &BTreeMap<String, serde_json::Va
     f
 }
 
+/// The parameters in a case's key: all of them but those [added later](crate::scenes::params::Spec::added_later)
+/// at their default, which reproduces the results computed before they existed.
+fn keyed_params(case: &Case) -> BTreeMap<String, serde_json::Value> {
+    let mut params = case.params.to_json();
+    if let Ok(entry) = crate::scenes::find(&case.scene) {
+        for spec in (entry.params)().iter().filter(|s| s.added_later) {
+            if params.get(spec.name) == serde_json::to_value(&spec.default).ok().as_ref() {
+                params.remove(spec.name);
+            }
+        }
+    }
+    params
+}
+
 /// The inputs of a case, written to `case.json` in its folder.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct CaseRecord {
@@ -57,7 +71,7 @@ pub struct CaseRecord {
 impl CaseRecord {
     /// The record of `case` of `problem` for this binary.
     pub fn new(problem: &str, case: &Case) -> Self {
-        let params = case.params.to_json();
+        let params = keyed_params(case);
         let solver = fingerprint_of_case(&case.scene, &params);
         let canonical = serde_json::json!({
             "scene": case.scene,
@@ -256,6 +270,28 @@ mod tests {
         let tg = crate::scenes::find("taylor_green").unwrap();
         assert!(tg.outputs > 0 && fingerprint_of("taylor_green") != fingerprint());
         assert_eq!(CaseRecord::new("p", &case(16)).solver, fingerprint_of("taylor_green"));
+    }
+
+    /// A parameter added later leaves the keys of the cases at its default as they were
+    /// before it existed, and renews those that set it.
+    #[test]
+    fn a_parameter_added_later_keeps_the_earlier_keys() {
+        let entry = crate::scenes::find("dam_break").unwrap();
+        let specs = (entry.params)();
+        assert!(specs.iter().any(|s| s.name == "wall_pressure" && s.added_later));
+        let with = |value: Option<&str>| {
+            let mut p = Params::defaults(&specs);
+            match value {
+                Some(v) => p.0.insert("wall_pressure".into(), Value::Str(v.into())),
+                None => p.0.remove("wall_pressure"),
+            };
+            CaseRecord::new("p", &Case { name: "a".into(), scene: "dam_break".into(), params: p })
+        };
+        let (before, default, clamped) = (with(None), with(Some("extrapolated")), with(Some("non_negative")));
+        assert_eq!(default.key, before.key);
+        assert!(!default.params.contains_key("wall_pressure"));
+        assert_ne!(clamped.key, before.key);
+        assert_eq!(clamped.changes_from(&before), "wall_pressure (none) -> \"non_negative\"");
     }
 
     /// A change to IPST alone renews the keys of the IPST cases only.

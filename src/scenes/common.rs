@@ -5,7 +5,7 @@ use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
-use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity};
+use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity, WallPressure};
 use crate::solver::scheme::{
     paper, Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
     SurfacePressure,
@@ -439,12 +439,26 @@ pub fn wall_density(p: &Params) -> WallDensity {
     WallDensity::from_name(p.str("wall_density")).expect("checked choice (wall_params)")
 }
 
+/// The wall pressure the parameters ask for (see [`wall_params`]).
+pub fn wall_pressure(p: &Params) -> WallPressure {
+    WallPressure::from_name(p.str("wall_pressure")).expect("checked choice (wall_params)")
+}
+
 /// The parameters of a scene with walls.
 pub fn wall_params() -> Vec<Spec> {
-    vec![Spec::choice(
-        "wall_density",
-        WallDensity::NAMES,
-        "state_equation",
-        "density of the wall particles: from their extrapolated pressure by the linear state equation (Adami 2012), or the reference density (PySPH's EDAC walls)",
-    )]
+    vec![
+        Spec::choice(
+            "wall_density",
+            WallDensity::NAMES,
+            "state_equation",
+            "density of the wall particles: from their extrapolated pressure by the linear state equation (Adami 2012), or the reference density (PySPH's EDAC walls)",
+        ),
+        Spec::choice(
+            "wall_pressure",
+            WallPressure::NAMES,
+            "extrapolated",
+            "pressure of the wall particles: eq. (52) as it stands, or clamped at zero so that walls never pull the fluid (PySPH's ClampWallPressure)",
+        )
+        .added_later(),
+    ]
 }

@@ -17,7 +17,7 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
+    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from, wall_pressure,
     wall_params, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
@@ -130,7 +130,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let fluid =
         fluid_at_rest(lattice(0.0, l, 0.0, hc, dx), dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
     let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
-        .with_density(wall_density(p));
+        .with_models(wall_density(p), wall_pressure(p));
     // Open above and around the tank: the run-up jets are fast (11-19 m/s measured at the
     // impact on the far wall, where the front of Ritter's solution runs at 2 sqrt(g H) =
     // 8.9 m/s), and a drop thrown out of the tank is splash, counted by `particles_lost`,

@@ -11,7 +11,7 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
+    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from, wall_pressure,
     wall_params, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
@@ -90,7 +90,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
     let wall =
         wall_from(&box_walls(width, 1.5 * height, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
-            .with_density(wall_density(p));
+            .with_models(wall_density(p), wall_pressure(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
     let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: 10.0 };

@@ -72,20 +72,23 @@ pub struct Spec {
     pub default: Value,
     /// One line of help (with units).
     pub help: &'static str,
+    /// Added after results were computed without it, with a default that reproduces them:
+    /// at its default it stays out of the cache key, so those results stay current.
+    pub added_later: bool,
 }
 
 impl Spec {
     /// An integer parameter.
     pub fn int(name: &'static str, default: i64, min: i64, help: &'static str) -> Self {
-        Self { name, kind: Kind::Int { min }, default: Value::Int(default), help }
+        Self { name, kind: Kind::Int { min }, default: Value::Int(default), help, added_later: false }
     }
     /// A float parameter.
     pub fn float(name: &'static str, default: f64, bound: Bound, help: &'static str) -> Self {
-        Self { name, kind: Kind::Float { bound }, default: Value::Float(default), help }
+        Self { name, kind: Kind::Float { bound }, default: Value::Float(default), help, added_later: false }
     }
     /// A boolean parameter.
     pub fn bool(name: &'static str, default: bool, help: &'static str) -> Self {
-        Self { name, kind: Kind::Bool, default: Value::Bool(default), help }
+        Self { name, kind: Kind::Bool, default: Value::Bool(default), help, added_later: false }
     }
     /// A choice parameter.
     pub fn choice(
@@ -94,7 +97,12 @@ impl Spec {
         default: &str,
         help: &'static str,
     ) -> Self {
-        Self { name, kind: Kind::Choice(choices), default: Value::Str(default.into()), help }
+        Self { name, kind: Kind::Choice(choices), default: Value::Str(default.into()), help, added_later: false }
+    }
+
+    /// The parameter marked [`added_later`](Self::added_later).
+    pub fn added_later(self) -> Self {
+        Self { added_later: true, ..self }
     }
 
     /// The kind in words, for help and errors.

@@ -5,7 +5,7 @@ mod fluid;
 mod wall;
 
 pub use fluid::{Fluid, FluidInit, FluidRates};
-pub use wall::{Wall, WallDensity};
+pub use wall::{Wall, WallDensity, WallPressure};
 
 /// Permutes `v` by `order` (`v_new[k] = v_old[order[k]]`) through a reusable scratch
 /// buffer, so reordering allocates nothing once the buffers have grown.

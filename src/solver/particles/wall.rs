@@ -38,6 +38,42 @@ impl WallDensity {
     }
 }
 
+/// The pressure a wall particle presents to the fluid.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum WallPressure {
+    /// Eq. (52) as it stands (Adami et al. 2012): negative where the fluid's is, so a wall
+    /// next to fluid under tension pulls that fluid towards it.
+    #[default]
+    Extrapolated,
+    /// Eq. (52) clamped at zero, as PySPH's `ClampWallPressure` does and the CTVF authors'
+    /// free-surface codes apply to every wall (the paper does not say): a wall pushes the
+    /// fluid away or not at all, never pulls it in.
+    NonNegative,
+}
+
+impl WallPressure {
+    /// Accepted names.
+    pub const NAMES: &'static [&'static str] = &["extrapolated", "non_negative"];
+
+    /// Parses a name from `NAMES`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Some(match s {
+            "extrapolated" => Self::Extrapolated,
+            "non_negative" => Self::NonNegative,
+            _ => return None,
+        })
+    }
+
+    /// The wall pressure from the extrapolated one, `p_w` of eq. (52).
+    #[inline(always)]
+    pub fn apply(self, p_w: f64) -> f64 {
+        match self {
+            Self::Extrapolated => p_w,
+            Self::NonNegative => p_w.max(0.0),
+        }
+    }
+}
+
 /// State of one wall body (struct of arrays).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Wall<const D: usize> {
@@ -59,6 +95,9 @@ pub struct Wall<const D: usize> {
     /// `wall_density` parameter).
     #[serde(default)]
     pub density: WallDensity,
+    /// How the wall's pressure follows the extrapolated one (`wall_pressure` parameter).
+    #[serde(default)]
+    pub pressure: WallPressure,
     /// Extrapolated values, eqs. (46)-(52): recomputed from the fluid before every use,
     /// so not part of a checkpoint.
     #[serde(skip)]
@@ -100,13 +139,14 @@ impl<const D: usize> Wall<D> {
             rho0,
             c0,
             density: WallDensity::default(),
+            pressure: WallPressure::default(),
             ghost,
         })
     }
 
-    /// The wall with its density model set.
-    pub fn with_density(self, density: WallDensity) -> Self {
-        Self { density, ..self }
+    /// The wall with its density and pressure models set.
+    pub fn with_models(self, density: WallDensity, pressure: WallPressure) -> Self {
+        Self { density, pressure, ..self }
     }
 
     /// Number of particles.
@@ -140,11 +180,22 @@ mod tests {
         let mut w = Wall::new("w", x.clone(), x, n, 1e-3, 1000.0, 20.0).unwrap();
         w.ghost[0].p = 800.0;
         assert_eq!(w.rho(0), 1002.0, "rho0 + p / c0^2 by default");
-        let w = w.with_density(WallDensity::Reference);
+        let w = w.with_models(WallDensity::Reference, WallPressure::Extrapolated);
         assert_eq!(w.rho(0), 1000.0);
         for name in WallDensity::NAMES {
             assert!(WallDensity::from_name(name).is_some());
         }
         assert_eq!(WallDensity::from_name("heavy"), None);
+    }
+
+    #[test]
+    fn a_non_negative_wall_pressure_never_pulls() {
+        assert_eq!(WallPressure::Extrapolated.apply(-3.0), -3.0);
+        assert_eq!(WallPressure::NonNegative.apply(-3.0), 0.0);
+        assert_eq!(WallPressure::NonNegative.apply(2.5), 2.5);
+        for name in WallPressure::NAMES {
+            assert!(WallPressure::from_name(name).is_some());
+        }
+        assert_eq!(WallPressure::from_name("clamped"), None);
     }
 }

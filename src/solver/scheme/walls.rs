@@ -50,7 +50,7 @@ impl<const D: usize> WallSet<D> {
     pub fn extrapolate(&mut self, fluid: &Fluid<D>, g: Vector<D>) {
         let (wall, list) = (&mut self.wall, &self.wall_to_fluid);
         let u_hat = fluid.u_hat();
-        let (x, u_wall, normal) = (&wall.x, &wall.u_wall, &wall.normal);
+        let (x, u_wall, normal, pressure) = (&wall.x, &wall.u_wall, &wall.normal, wall.pressure);
         wall.ghost.resize(
             x.len(),
             ghost(&WallSums::default(), Vector::zeros(), true, Vector::zeros(), Vector::zeros(), g),
@@ -62,6 +62,7 @@ impl<const D: usize> WallSet<D> {
             });
             // The wall particles do not move: their velocity is the slip of a sliding surface.
             *out = ghost(&s, u_wall[i], true, Vector::zeros(), normal[i], g);
+            out.p = pressure.apply(out.p);
         });
     }
 }
