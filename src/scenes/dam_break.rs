@@ -17,8 +17,8 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from, wall_pressure,
-    wall_params, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
+    wall_params, wall_pressure, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};

@@ -97,7 +97,13 @@ impl Spec {
         default: &str,
         help: &'static str,
     ) -> Self {
-        Self { name, kind: Kind::Choice(choices), default: Value::Str(default.into()), help, added_later: false }
+        Self {
+            name,
+            kind: Kind::Choice(choices),
+            default: Value::Str(default.into()),
+            help,
+            added_later: false,
+        }
     }
 
     /// The parameter marked [`added_later`](Self::added_later).
