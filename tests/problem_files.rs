@@ -272,9 +272,13 @@ fn dam_break_presets_figures_and_stability_sweep() {
             panic!()
         };
         assert_eq!(r.x.len(), 9);
-        // ctvf sun (with and without corrections) and ipst at the main resolution.
+        // ctvf sun (with and without corrections) and ipst at the main resolution, with the
+        // paper's equations and with the surface at p = 0 and the walls clamped.
         let at: Vec<_> = p.cases.iter().filter(|c| c.params.float("dx") == dx).collect();
-        assert_eq!(at.len(), 3, "{at:?}");
+        assert_eq!(at.len(), 6, "{at:?}");
+        let clamped: Vec<_> = at.iter().filter(|c| c.params.str("wall_pressure") == "non_negative").collect();
+        assert_eq!(clamped.len(), 3);
+        assert!(clamped.iter().all(|c| c.params.str("surface_pressure") == "zero"));
     }
     assert_eq!(dxs(&quick), [0.05, 0.1]);
     let (sq, sp) = (load("dam_break_stability", "quick"), load("dam_break_stability", "paper"));

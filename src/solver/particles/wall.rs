@@ -45,8 +45,8 @@ pub enum WallPressure {
     /// next to fluid under tension pulls that fluid towards it.
     #[default]
     Extrapolated,
-    /// Eq. (52) clamped at zero, as PySPH's `ClampWallPressure` does and the CTVF authors'
-    /// free-surface codes apply to every wall (the paper does not say): a wall pushes the
+    /// Eq. (52) clamped at zero, as PySPH's `ClampWallPressure` does (an option of the CTVF
+    /// authors' code, `--clamp-pressure`; the paper does not mention it): a wall pushes the
     /// fluid away or not at all, never pulls it in.
     NonNegative,
 }
