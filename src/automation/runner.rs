@@ -90,16 +90,11 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
     Ok((tasks, done))
 }
 
-/// Cores available to this process.
-pub fn cores() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
-}
-
-/// Concurrent cases and rayon threads per case for `tasks` cases: jobs x threads <= cores.
-pub fn split_cores(jobs: Option<usize>, tasks: usize) -> (usize, usize) {
-    let cores = cores();
-    let jobs = jobs.unwrap_or_else(|| cores.min(tasks)).max(1);
-    (jobs, (cores / jobs).max(1))
+/// Concurrent cases and rayon threads per case for `tasks` cases within a budget of
+/// `threads` (the `--threads` of the command, else every core): jobs x threads <= budget.
+pub fn split_cores(jobs: Option<usize>, tasks: usize, threads: usize) -> (usize, usize) {
+    let jobs = jobs.unwrap_or_else(|| threads.min(tasks)).max(1);
+    (jobs, (threads / jobs).max(1))
 }
 
 /// Prints a line above the progress bars.
@@ -111,7 +106,7 @@ fn say(mp: &MultiProgress, line: String) {
 /// new cases and lets the running ones write their `failed` summary.
 pub fn execute(tasks: Vec<Task>, opts: &Options) -> Result<Report, String> {
     let exe = std::env::current_exe().map_err(|e| format!("cannot find own executable: {e}"))?;
-    let (jobs, threads) = split_cores(opts.jobs, tasks.len());
+    let (jobs, threads) = split_cores(opts.jobs, tasks.len(), rayon::current_num_threads());
     let checkpoint = opts.checkpoint_every;
     let mp = MultiProgress::with_draw_target(if std::io::stderr().is_terminal() {
         ProgressDrawTarget::stderr()
@@ -317,5 +312,18 @@ fn short(s: &str, n: usize) -> String {
     } else {
         let tail: String = s.chars().rev().take(n - 1).collect::<Vec<_>>().into_iter().rev().collect();
         format!("…{tail}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::split_cores;
+
+    #[test]
+    fn cases_share_the_thread_budget() {
+        assert_eq!(split_cores(None, 10, 2), (2, 1), "one thread a case, two at a time");
+        assert_eq!(split_cores(None, 1, 2), (1, 2), "a lone case takes both");
+        assert_eq!(split_cores(Some(1), 5, 1), (1, 1), "--threads 1 --jobs 1");
+        assert_eq!(split_cores(Some(4), 5, 2), (4, 1), "more jobs than threads: one each");
     }
 }
