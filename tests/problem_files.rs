@@ -285,7 +285,7 @@ fn dam_break_presets_figures_and_stability_sweep() {
     // The quick sweep stops at dx = 0.05 to keep `reproduce` within minutes.
     assert_eq!(dxs(&sq), [0.05, 0.1]);
     assert_eq!(dxs(&sp), [0.0125, 0.025, 0.05, 0.1]);
-    assert_eq!((sq.cases.len(), sp.cases.len()), (6, 12));
+    assert_eq!((sq.cases.len(), sp.cases.len()), (12, 24));
     assert!(sq.cases.iter().all(|c| c.params.float("tf") == 1.0));
     let fs = load("free_surface", "quick");
     let shapes: Vec<_> = fs.cases.iter().map(|c| c.params.str("shape").to_string()).collect();
