@@ -23,25 +23,19 @@ pub enum KernelKind {
 }
 
 impl KernelKind {
-    /// Names accepted on the command line, in the order of the enum.
-    pub const NAMES: &'static [&'static str] = &["cubic_spline", "quintic_spline", "wendland_c2", "gaussian"];
-
-    /// Parses a kernel name as written in `NAMES`.
-    pub fn from_name(name: &str) -> Option<Self> {
-        Some(match name {
-            "cubic_spline" => Self::CubicSpline,
-            "quintic_spline" => Self::QuinticSpline,
-            "wendland_c2" => Self::WendlandC2,
-            "gaussian" => Self::Gaussian,
-            _ => return None,
-        })
-    }
-
     /// The name `from_name` accepts.
     pub fn name(self) -> &'static str {
         Self::NAMES[self as usize]
     }
 }
+
+// In the order of the enum: `name` indexes `NAMES` by variant.
+named_choices!(KernelKind {
+    CubicSpline => "cubic_spline",
+    QuinticSpline => "quintic_spline",
+    WendlandC2 => "wendland_c2",
+    Gaussian => "gaussian",
+});
 
 /// A kernel bound to a dimension: `sigma` is the normalisation for that `D`.
 #[derive(Clone, Copy, Debug)]

@@ -6,6 +6,25 @@
 //! - [`integrator`]: kick-drift-kick and the time step; [`simulation`]: the run loop;
 //! - [`output`]: ParaView snapshots, time series and the run summary.
 
+/// `NAMES` (the accepted names, in order) and `from_name` for an enum of choices, each
+/// variant's name written once so the two cannot disagree.
+macro_rules! named_choices {
+    ($ty:ident { $($variant:ident => $name:literal),+ $(,)? }) => {
+        impl $ty {
+            /// Accepted names.
+            pub const NAMES: &'static [&'static str] = &[$($name),+];
+
+            /// Parses a name from `NAMES`.
+            pub fn from_name(s: &str) -> Option<Self> {
+                match s {
+                    $($name => Some(Self::$variant),)+
+                    _ => None,
+                }
+            }
+        }
+    };
+}
+
 pub mod equations;
 pub mod integrator;
 pub mod kernel;

@@ -24,19 +24,10 @@ pub enum WallDensity {
     Reference,
 }
 
-impl WallDensity {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["state_equation", "reference"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "state_equation" => Self::StateEquation,
-            "reference" => Self::Reference,
-            _ => return None,
-        })
-    }
-}
+named_choices!(WallDensity {
+    StateEquation => "state_equation",
+    Reference => "reference",
+});
 
 /// The pressure a wall particle presents to the fluid.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -52,18 +43,6 @@ pub enum WallPressure {
 }
 
 impl WallPressure {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["extrapolated", "non_negative"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "extrapolated" => Self::Extrapolated,
-            "non_negative" => Self::NonNegative,
-            _ => return None,
-        })
-    }
-
     /// The wall pressure from the extrapolated one, `p_w` of eq. (52).
     #[inline(always)]
     pub fn apply(self, p_w: f64) -> f64 {
@@ -73,6 +52,11 @@ impl WallPressure {
         }
     }
 }
+
+named_choices!(WallPressure {
+    Extrapolated => "extrapolated",
+    NonNegative => "non_negative",
+});
 
 /// State of one wall body (struct of arrays).
 #[derive(Clone, Debug, Serialize, Deserialize)]

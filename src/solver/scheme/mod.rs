@@ -36,20 +36,11 @@ pub enum SchemeName {
     Ctvf,
 }
 
-impl SchemeName {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["edac", "tvf", "ctvf"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "edac" => Self::Edac,
-            "tvf" => Self::Tvf,
-            "ctvf" => Self::Ctvf,
-            _ => return None,
-        })
-    }
-}
+named_choices!(SchemeName {
+    Edac => "edac",
+    Tvf => "tvf",
+    Ctvf => "ctvf",
+});
 
 /// Particle shifting technique for CTVF.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -63,20 +54,11 @@ pub enum Pst {
     None,
 }
 
-impl Pst {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["sun", "ipst", "none"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "sun" => Self::Sun,
-            "ipst" => Self::Ipst,
-            "none" => Self::None,
-            _ => return None,
-        })
-    }
-}
+named_choices!(Pst {
+    Sun => "sun",
+    Ipst => "ipst",
+    None => "none",
+});
 
 /// The reference pressure subtracted from `p_a` and `p_b` in the pressure gradient.
 ///
@@ -108,20 +90,6 @@ pub enum PressureReference {
 }
 
 impl PressureReference {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["auto", "local_mean", "global_mean", "none"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "auto" => Self::Auto,
-            "local_mean" => Self::LocalMean,
-            "global_mean" => Self::GlobalMean,
-            "none" => Self::None,
-            _ => return None,
-        })
-    }
-
     /// Whether a reference pressure is subtracted, given the scheme's own choice (BQL or
     /// none) for `Auto`.
     pub fn bql(self, scheme_default: bool) -> bool {
@@ -132,6 +100,13 @@ impl PressureReference {
         }
     }
 }
+
+named_choices!(PressureReference {
+    Auto => "auto",
+    LocalMean => "local_mean",
+    GlobalMean => "global_mean",
+    None => "none",
+});
 
 /// What the pressure of the free-surface particles (sec. 3.4) does. The paper's text
 /// evolves every particle's pressure by eq. (26); the authors' public PySPH code can also
@@ -157,21 +132,12 @@ pub enum SurfacePressure {
     NonNegative,
 }
 
-impl SurfacePressure {
-    /// Accepted names.
-    pub const NAMES: &'static [&'static str] = &["evolve", "zero", "zero_isolated", "non_negative"];
-
-    /// Parses a name from `NAMES`.
-    pub fn from_name(s: &str) -> Option<Self> {
-        Some(match s {
-            "zero" => Self::Zero,
-            "zero_isolated" => Self::ZeroIsolated,
-            "non_negative" => Self::NonNegative,
-            "evolve" => Self::Evolve,
-            _ => return None,
-        })
-    }
-}
+named_choices!(SurfacePressure {
+    Evolve => "evolve",
+    Zero => "zero",
+    ZeroIsolated => "zero_isolated",
+    NonNegative => "non_negative",
+});
 
 /// A free surface: detected every step (sec. 3.4), the shifting kept tangential near it
 /// (sec. 3.5).
