@@ -170,7 +170,9 @@ enum Command {
         /// A peer code's runner to measure in the same sitting, e.g.
         /// `../shared/peers/pysph-taylor-green.sh`: called with `--nx N --tf T --threads K`
         /// for every resolution and thread count, it must print one JSON line with
-        /// `particle_steps_per_second`; the table then gives our ratio to it at each size and, when nx = 50 is among the resolutions, to its nx = 50 run (the figure to beat).
+        /// `particle_steps_per_second`; the table then gives our ratio to it at each size
+        /// and, when nx = 50 is among the resolutions, to its nx = 50 run (the issue's
+        /// figure to beat).
         #[arg(long)]
         peer: Option<PathBuf>,
         /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
