@@ -273,12 +273,17 @@ fn dam_break_presets_figures_and_stability_sweep() {
         };
         assert_eq!(r.x.len(), 9);
         // ctvf sun (with and without corrections) and ipst at the main resolution, with the
-        // paper's equations and with the surface at p = 0 and the walls clamped.
+        // paper's equations and with the surface at p = 0 and the walls clamped; with the
+        // latter, ipst also on every fifth step (the authors' code's default).
         let at: Vec<_> = p.cases.iter().filter(|c| c.params.float("dx") == dx).collect();
-        assert_eq!(at.len(), 6, "{at:?}");
+        assert_eq!(at.len(), 7, "{at:?}");
         let clamped: Vec<_> = at.iter().filter(|c| c.params.str("wall_pressure") == "non_negative").collect();
-        assert_eq!(clamped.len(), 3);
+        assert_eq!(clamped.len(), 4);
         assert!(clamped.iter().all(|c| c.params.str("surface_pressure") == "zero"));
+        let every5: Vec<_> = at.iter().filter(|c| c.params.int("ipst_interval") == 5).collect();
+        assert_eq!(every5.len(), 1);
+        assert_eq!(every5[0].params.str("pst"), "ipst");
+        assert_eq!(every5[0].params.str("wall_pressure"), "non_negative");
     }
     assert_eq!(dxs(&quick), [0.05, 0.1]);
     let (sq, sp) = (load("dam_break_stability", "quick"), load("dam_break_stability", "paper"));
