@@ -96,6 +96,37 @@ pub struct BenchResult {
     pub ipst_iterations_mean: f64,
     /// Share of the timed steps spent in each phase.
     pub phase_shares: crate::solver::simulation::PhaseTimes,
+    /// Particle-steps per second of every run of this configuration (`bench --repeat`), in
+    /// the order they ran; the fields above are those of the median run (see
+    /// [`median_runs`]).
+    #[serde(default)]
+    pub runs: Vec<f64>,
+}
+
+/// One result per configuration (variant, kernel, nx, threads) from repeated runs of each,
+/// in the order the configurations first appear: the run of median throughput (of an even
+/// count, the slower of the two middle ones), so that its phase shares and memory belong
+/// to the throughput reported, with every run's throughput in `runs`. A slow spell of the
+/// machine then moves the reported figure only if it lasts through half the runs.
+pub fn median_runs(samples: Vec<BenchResult>) -> Vec<BenchResult> {
+    let key = |r: &BenchResult| (r.variant.clone(), r.kernel.clone(), r.nx, r.threads);
+    let mut groups: Vec<Vec<BenchResult>> = Vec::new();
+    for r in samples {
+        match groups.iter_mut().find(|g| key(&g[0]) == key(&r)) {
+            Some(g) => g.push(r),
+            None => groups.push(vec![r]),
+        }
+    }
+    groups
+        .into_iter()
+        .map(|g| {
+            let runs: Vec<f64> = g.iter().map(|r| r.particle_steps_per_second).collect();
+            let mut order: Vec<usize> = (0..g.len()).collect();
+            order.sort_by(|&a, &b| runs[a].total_cmp(&runs[b]));
+            let mid = order[(g.len() - 1) / 2];
+            BenchResult { runs, ..g[mid].clone() }
+        })
+        .collect()
 }
 
 /// The kernel of the cases unless `--kernel` names another: the paper's and PySPH's.
@@ -170,6 +201,7 @@ pub fn run_case(
         bytes_per_particle: hwm.saturating_sub(rss0) as f64 / n as f64,
         ipst_iterations_mean: ipst as f64 / steps as f64,
         phase_shares: sim.times.scaled(1.0 / seconds),
+        runs: Vec::new(),
     })
 }
 
@@ -181,7 +213,15 @@ pub fn default_steps(n: usize) -> u64 {
 /// The peer resolution of the issue's figure to beat: PySPH's Taylor-Green at nx = 50.
 pub const FIGURE_TO_BEAT_NX: usize = 50;
 
-/// The benchmark table as Markdown, with the throughput of each variant relative to
+/// The smallest and largest of `v`, if any.
+fn minmax(v: &[f64]) -> Option<(f64, f64)> {
+    let lo = v.iter().copied().reduce(f64::min)?;
+    let hi = v.iter().copied().reduce(f64::max)?;
+    Some((lo, hi))
+}
+
+/// The benchmark table as Markdown (throughput of the median run, with the range over the
+/// runs when there were several), with the throughput of each variant relative to
 /// `edac` on the same size and threads, and the two-thread speed-up; with peer results, the
 /// peer's throughput and our ratio to it on the same size and threads, our ratio to the
 /// peer's run at [`FIGURE_TO_BEAT_NX`] on the same threads (the issue states one figure to
@@ -224,14 +264,20 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             100.0 * p.ipst,
             100.0 * p.integrate
         );
+        let speed = match minmax(&r.runs) {
+            Some((lo, hi)) if r.runs.len() > 1 => {
+                format!("{:.3} ({:.3}-{:.3})", r.particle_steps_per_second / 1e6, lo / 1e6, hi / 1e6)
+            }
+            _ => format!("{:.3}", r.particle_steps_per_second / 1e6),
+        };
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {:.3} | {:.0} | {:.0} | {} | {} | {:.2} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {} | {} | {:.2} | {} |\n",
             r.variant,
             r.nx,
             r.particles,
             r.threads,
             r.steps,
-            r.particle_steps_per_second / 1e6,
+            speed,
             1e9 / r.particle_steps_per_second,
             r.bytes_per_particle,
             cost,
@@ -305,6 +351,7 @@ mod peer_tests {
             bytes_per_particle: 0.0,
             ipst_iterations_mean: 0.0,
             phase_shares: Default::default(),
+            runs: Vec::new(),
         };
         let out = "{\"particle_steps_per_second\": 3.0e5, \"l1_velocity_final\": 0.02, \"t_final\": 2.0}";
         let mut peer = parse_peer(out, 50, 2, 2.0).unwrap();
@@ -326,6 +373,61 @@ mod peer_tests {
             &[PeerResult { nx: 400, ..parse_peer(out, 400, 2, 0.02).unwrap() }],
         );
         assert!(t.lines().nth(2).unwrap().contains("| 0.300 | 18.0x |  |"), "{t}");
+    }
+
+    /// Repeated runs: the median one is kept whole (its phase shares with its throughput),
+    /// every run's throughput beside it, and the table gives the range.
+    #[test]
+    fn repeated_runs_report_the_median_run_and_the_range() {
+        let run = |variant: &str, threads: usize, speed: f64, seconds: f64| BenchResult {
+            variant: variant.into(),
+            kernel: DEFAULT_KERNEL.into(),
+            nx: 100,
+            threads,
+            particles: 10_000,
+            steps: 400,
+            seconds,
+            particle_steps_per_second: speed,
+            peak_rss_bytes: 0,
+            bytes_per_particle: 0.0,
+            ipst_iterations_mean: 0.0,
+            phase_shares: Default::default(),
+            runs: Vec::new(),
+        };
+        // Three rounds over edac on one and two threads, then ctvf+ipst on one.
+        let samples = vec![
+            run("edac", 1, 3.0e6, 1.0),
+            run("edac", 2, 5.0e6, 2.0),
+            run("edac", 1, 1.0e6, 3.0),
+            run("edac", 2, 6.0e6, 4.0),
+            run("edac", 1, 2.0e6, 5.0),
+            run("edac", 2, 4.0e6, 6.0),
+            run("ctvf+ipst", 1, 1.0e6, 7.0),
+        ];
+        let r = median_runs(samples);
+        let got: Vec<_> =
+            r.iter().map(|r| (r.variant.as_str(), r.threads, r.seconds, r.runs.clone())).collect();
+        assert_eq!(
+            got,
+            [
+                ("edac", 1, 5.0, vec![3.0e6, 1.0e6, 2.0e6]),
+                ("edac", 2, 2.0, vec![5.0e6, 6.0e6, 4.0e6]),
+                ("ctvf+ipst", 1, 7.0, vec![1.0e6]),
+            ]
+        );
+        // Of an even count, the slower of the two middle runs.
+        let two = median_runs(vec![run("edac", 1, 2.0e6, 1.0), run("edac", 1, 1.0e6, 2.0)]);
+        assert_eq!(two[0].seconds, 2.0);
+        let t = table(&r, &[]);
+        let rows: Vec<&str> = t.lines().collect();
+        assert!(rows[2].contains("| 2.000 (1.000-3.000) | 500 |"), "{}", rows[2]);
+        // The speed-up and the cost compare the median runs.
+        assert!(
+            rows[3].contains("| 5.000 (4.000-6.000) | 200 |") && rows[3].contains("| 1.00 | 2.50 |"),
+            "{}",
+            rows[3]
+        );
+        assert!(rows[4].contains("| 1.000 | 1000 |") && rows[4].contains("| 2.00 |"), "{}", rows[4]);
     }
 
     #[test]

@@ -164,6 +164,11 @@ enum Command {
         /// Timed steps per case (default: about 4 million particle-steps).
         #[arg(long)]
         steps: Option<u64>,
+        /// Runs of every case, in as many rounds over all the cases (so that a slow spell
+        /// of the machine falls on every variant alike); the table gives the median run
+        /// and the range, the JSON every run's throughput.
+        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+        repeat: u32,
         /// Where to write the results as JSON.
         #[arg(long, default_value = "output/bench.json")]
         json: PathBuf,
@@ -314,8 +319,8 @@ fn run(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Bench { nx, bench_threads, variants, steps, json, peer, kernel } => {
-            run_bench(nx, bench_threads, variants, steps, json, peer, &kernel)
+        Command::Bench { nx, bench_threads, variants, steps, repeat, json, peer, kernel } => {
+            run_bench(nx, bench_threads, variants, steps, repeat, json, peer, &kernel)
         }
         Command::BenchCase { variant, nx, steps, kernel } => {
             match bench::run_case(&variant, nx, steps, 5, &kernel) {
@@ -364,11 +369,47 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &s
         .ok_or_else(|| "summary.json: no `l1_velocity_final`".to_string())
 }
 
+/// One benchmark configuration, timed in a process of its own (`bench-case`) so that each
+/// starts from the same memory state and its peak memory is its own.
+fn bench_case(
+    exe: &std::path::Path,
+    variant: &str,
+    nx: usize,
+    threads: usize,
+    steps: u64,
+    kernel: &str,
+) -> Result<bench::BenchResult, String> {
+    let (nx, threads, steps) = (nx.to_string(), threads.to_string(), steps.to_string());
+    let args = [
+        "--threads",
+        &threads,
+        "bench-case",
+        "--variant",
+        variant,
+        "--nx",
+        &nx,
+        "--steps",
+        &steps,
+        "--kernel",
+        kernel,
+    ];
+    let o = std::process::Command::new(exe)
+        .args(args)
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if !o.status.success() {
+        return Err(format!("failed: {}", String::from_utf8_lossy(&o.stderr)));
+    }
+    serde_json::from_slice(&o.stdout).map_err(|e| format!("unreadable result: {e}"))
+}
+
+#[allow(clippy::too_many_arguments)]
 fn run_bench(
     nx: Vec<usize>,
     threads: Vec<usize>,
     variants: Option<Vec<String>>,
     steps: Option<u64>,
+    repeat: u32,
     json: PathBuf,
     peer: Option<PathBuf>,
     kernel: &str,
@@ -384,51 +425,28 @@ fn run_bench(
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
     let exe = std::env::current_exe().expect("own executable");
     let mut results = Vec::new();
-    for &n in &nx {
-        for v in &variants {
-            for &t in &threads {
-                let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-                eprint!("bench {v} nx={n} threads={t} steps={k} ... ");
-                let out = std::process::Command::new(&exe)
-                    .args([
-                        "--threads",
-                        &t.to_string(),
-                        "bench-case",
-                        "--variant",
-                        v,
-                        "--nx",
-                        &n.to_string(),
-                        "--steps",
-                        &k.to_string(),
-                        "--kernel",
-                        kernel,
-                    ])
-                    .output();
-                match out {
-                    Ok(o) if o.status.success() => {
-                        match serde_json::from_slice::<bench::BenchResult>(&o.stdout) {
-                            Ok(r) => {
-                                eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
-                                results.push(r);
-                            }
-                            Err(e) => {
-                                eprintln!("unreadable result: {e}");
-                                return ExitCode::from(1);
-                            }
+    for round in 1..=repeat {
+        for &n in &nx {
+            for v in &variants {
+                for &t in &threads {
+                    let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
+                    let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
+                    eprint!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
+                    match bench_case(&exe, v, n, t, k, kernel) {
+                        Ok(r) => {
+                            eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
+                            results.push(r);
                         }
-                    }
-                    Ok(o) => {
-                        eprintln!("failed: {}", String::from_utf8_lossy(&o.stderr));
-                        return ExitCode::from(1);
-                    }
-                    Err(e) => {
-                        eprintln!("cannot run {}: {e}", exe.display());
-                        return ExitCode::from(1);
+                        Err(e) => {
+                            eprintln!("{e}");
+                            return ExitCode::from(1);
+                        }
                     }
                 }
             }
         }
     }
+    let results = bench::median_runs(results);
     let mut peers = Vec::new();
     if let Some(script) = &peer {
         for &n in &nx {

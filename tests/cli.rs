@@ -246,3 +246,31 @@ fn bench_measures_a_peer_in_the_same_sitting() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--kernel spline9"));
 }
+
+/// `bench --repeat 3`: each configuration once in the results, with its three runs, and the
+/// reported run is the median of them; `--repeat 0` is refused.
+#[test]
+fn bench_repeats_every_case_and_reports_the_median_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("bench.json");
+    let bin = env!("CARGO_BIN_EXE_sphrepro");
+    let out = Command::new(bin)
+        .args(["bench", "--nx", "20", "--bench-threads", "1,2", "--variants", "edac", "--steps", "5"])
+        .args(["--repeat", "3", "--json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(String::from_utf8_lossy(&out.stderr).matches("(run 3 of 3)").count(), 2);
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let results = v.as_array().unwrap();
+    assert_eq!(results.len(), 2);
+    for r in results {
+        let mut runs: Vec<f64> = r["runs"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        assert_eq!(runs.len(), 3);
+        runs.sort_by(f64::total_cmp);
+        assert_eq!(r["particle_steps_per_second"].as_f64().unwrap(), runs[1]);
+    }
+    let out = Command::new(bin).args(["bench", "--repeat", "0"]).output().unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--repeat"));
+}
