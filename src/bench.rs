@@ -325,6 +325,25 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
 mod peer_tests {
     use super::*;
 
+    /// A measured configuration with nothing but its name and throughput.
+    fn sample(variant: &str, nx: usize, threads: usize, speed: f64) -> BenchResult {
+        BenchResult {
+            variant: variant.into(),
+            kernel: DEFAULT_KERNEL.into(),
+            nx,
+            threads,
+            particles: nx * nx,
+            steps: 100,
+            seconds: 1.0,
+            particle_steps_per_second: speed,
+            peak_rss_bytes: 0,
+            bytes_per_particle: 0.0,
+            ipst_iterations_mean: 0.0,
+            phase_shares: Default::default(),
+            runs: Vec::new(),
+        }
+    }
+
     #[test]
     fn peers_run_t_2_where_it_is_cheap_and_about_70_million_particle_steps_beyond() {
         assert_eq!(peer_tf(50), 2.0);
@@ -338,21 +357,7 @@ mod peer_tests {
     /// The peer columns: its throughput, our ratio to it, and both L1 errors on edac's row.
     #[test]
     fn the_table_compares_throughput_and_accuracy_with_the_peer() {
-        let ours = |variant: &str, speed: f64| BenchResult {
-            variant: variant.into(),
-            kernel: DEFAULT_KERNEL.into(),
-            nx: 50,
-            threads: 2,
-            particles: 2500,
-            steps: 100,
-            seconds: 1.0,
-            particle_steps_per_second: speed,
-            peak_rss_bytes: 0,
-            bytes_per_particle: 0.0,
-            ipst_iterations_mean: 0.0,
-            phase_shares: Default::default(),
-            runs: Vec::new(),
-        };
+        let ours = |variant: &str, speed: f64| sample(variant, 50, 2, speed);
         let out = "{\"particle_steps_per_second\": 3.0e5, \"l1_velocity_final\": 0.02, \"t_final\": 2.0}";
         let mut peer = parse_peer(out, 50, 2, 2.0).unwrap();
         peer.sphrepro_l1_velocity_final = Some(0.0115);
@@ -379,20 +384,10 @@ mod peer_tests {
     /// every run's throughput beside it, and the table gives the range.
     #[test]
     fn repeated_runs_report_the_median_run_and_the_range() {
+        // `seconds` tells the runs apart.
         let run = |variant: &str, threads: usize, speed: f64, seconds: f64| BenchResult {
-            variant: variant.into(),
-            kernel: DEFAULT_KERNEL.into(),
-            nx: 100,
-            threads,
-            particles: 10_000,
-            steps: 400,
             seconds,
-            particle_steps_per_second: speed,
-            peak_rss_bytes: 0,
-            bytes_per_particle: 0.0,
-            ipst_iterations_mean: 0.0,
-            phase_shares: Default::default(),
-            runs: Vec::new(),
+            ..sample(variant, 100, threads, speed)
         };
         // Three rounds over edac on one and two threads, then ctvf+ipst on one.
         let samples = vec![
