@@ -31,6 +31,10 @@ pub struct PeerResult {
     /// sphrepro `edac`'s L1 velocity error on the same run (size, Re = 100, end time).
     #[serde(default)]
     pub sphrepro_l1_velocity_final: Option<f64>,
+    /// Particle-steps per second of every run of the peer at this size and thread count
+    /// (`bench --repeat`), in the order they ran; the fields above are the median run's.
+    #[serde(default)]
+    pub runs: Vec<f64>,
 }
 
 impl PeerResult {
@@ -66,6 +70,7 @@ pub fn parse_peer(stdout: &str, nx: usize, threads: usize, tf: f64) -> Result<Pe
         t_final: v["t_final"].as_f64(),
         l1_velocity_final: v["l1_velocity_final"].as_f64(),
         sphrepro_l1_velocity_final: None,
+        runs: Vec::new(),
     })
 }
 
@@ -103,16 +108,54 @@ pub struct BenchResult {
     pub runs: Vec<f64>,
 }
 
-/// One result per configuration (variant, kernel, nx, threads) from repeated runs of each,
-/// in the order the configurations first appear: the run of median throughput (of an even
-/// count, the slower of the two middle ones), so that its phase shares and memory belong
-/// to the throughput reported, with every run's throughput in `runs`. A slow spell of the
-/// machine then moves the reported figure only if it lasts through half the runs.
-pub fn median_runs(samples: Vec<BenchResult>) -> Vec<BenchResult> {
-    let key = |r: &BenchResult| (r.variant.clone(), r.kernel.clone(), r.nx, r.threads);
-    let mut groups: Vec<Vec<BenchResult>> = Vec::new();
+/// A timed run that may be repeated: what makes two runs the same configuration, its
+/// throughput, and where the throughputs of all its runs go.
+pub trait Repeated: Clone {
+    /// The configuration.
+    type Key: PartialEq;
+    /// The configuration of this run.
+    fn key(&self) -> Self::Key;
+    /// Its particle-steps per second.
+    fn speed(&self) -> f64;
+    /// The throughputs of every run of its configuration.
+    fn runs_mut(&mut self) -> &mut Vec<f64>;
+}
+
+impl Repeated for BenchResult {
+    type Key = (String, String, usize, usize);
+    fn key(&self) -> Self::Key {
+        (self.variant.clone(), self.kernel.clone(), self.nx, self.threads)
+    }
+    fn speed(&self) -> f64 {
+        self.particle_steps_per_second
+    }
+    fn runs_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.runs
+    }
+}
+
+impl Repeated for PeerResult {
+    type Key = (usize, usize);
+    fn key(&self) -> Self::Key {
+        (self.nx, self.threads)
+    }
+    fn speed(&self) -> f64 {
+        self.particle_steps_per_second
+    }
+    fn runs_mut(&mut self) -> &mut Vec<f64> {
+        &mut self.runs
+    }
+}
+
+/// One result per configuration from repeated runs of each, in the order the
+/// configurations first appear: the run of median throughput (of an even count, the slower
+/// of the two middle ones), so that its phase shares and memory belong to the throughput
+/// reported, with every run's throughput in `runs`. A slow spell of the machine then moves
+/// the reported figure only if it lasts through half the runs.
+pub fn median_runs<T: Repeated>(samples: Vec<T>) -> Vec<T> {
+    let mut groups: Vec<Vec<T>> = Vec::new();
     for r in samples {
-        match groups.iter_mut().find(|g| key(&g[0]) == key(&r)) {
+        match groups.iter_mut().find(|g| g[0].key() == r.key()) {
             Some(g) => g.push(r),
             None => groups.push(vec![r]),
         }
@@ -120,11 +163,12 @@ pub fn median_runs(samples: Vec<BenchResult>) -> Vec<BenchResult> {
     groups
         .into_iter()
         .map(|g| {
-            let runs: Vec<f64> = g.iter().map(|r| r.particle_steps_per_second).collect();
+            let runs: Vec<f64> = g.iter().map(T::speed).collect();
             let mut order: Vec<usize> = (0..g.len()).collect();
             order.sort_by(|&a, &b| runs[a].total_cmp(&runs[b]));
-            let mid = order[(g.len() - 1) / 2];
-            BenchResult { runs, ..g[mid].clone() }
+            let mut median = g[order[(g.len() - 1) / 2]].clone();
+            *median.runs_mut() = runs;
+            median
         })
         .collect()
 }
@@ -213,11 +257,15 @@ pub fn default_steps(n: usize) -> u64 {
 /// The peer resolution of the figure to beat: PySPH's Taylor-Green at nx = 50.
 pub const FIGURE_TO_BEAT_NX: usize = 50;
 
-/// The smallest and largest of `v`, if any.
-fn minmax(v: &[f64]) -> Option<(f64, f64)> {
-    let lo = v.iter().copied().reduce(f64::min)?;
-    let hi = v.iter().copied().reduce(f64::max)?;
-    Some((lo, hi))
+/// A throughput in millions, with the range over `runs` when there were several.
+fn millions(speed: f64, runs: &[f64]) -> String {
+    let lo = runs.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = runs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    if runs.len() > 1 {
+        format!("{:.3} ({:.3}-{:.3})", speed / 1e6, lo / 1e6, hi / 1e6)
+    } else {
+        format!("{:.3}", speed / 1e6)
+    }
 }
 
 /// The benchmark table as Markdown (throughput of the median run, with the range over the
@@ -264,12 +312,7 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             100.0 * p.ipst,
             100.0 * p.integrate
         );
-        let speed = match minmax(&r.runs) {
-            Some((lo, hi)) if r.runs.len() > 1 => {
-                format!("{:.3} ({:.3}-{:.3})", r.particle_steps_per_second / 1e6, lo / 1e6, hi / 1e6)
-            }
-            _ => format!("{:.3}", r.particle_steps_per_second / 1e6),
-        };
+        let speed = millions(r.particle_steps_per_second, &r.runs);
         s.push_str(&format!(
             "| {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {} | {} | {:.2} | {} |\n",
             r.variant,
@@ -308,8 +351,8 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
                     s.insert_str(
                         s.len() - 1,
                         &format!(
-                            " {:.3} | {:.1}x | {at_50} | {l1} |",
-                            p.particle_steps_per_second / 1e6,
+                            " {} | {:.1}x | {at_50} | {l1} |",
+                            millions(p.particle_steps_per_second, &p.runs),
                             r.particle_steps_per_second / p.particle_steps_per_second
                         ),
                     )

@@ -164,9 +164,9 @@ enum Command {
         /// Timed steps per case (default: about 4 million particle-steps).
         #[arg(long)]
         steps: Option<u64>,
-        /// Runs of every case, in as many rounds over all the cases (so that a slow spell
-        /// of the machine falls on every variant alike); the table gives the median run
-        /// and the range, the JSON every run's throughput.
+        /// Runs of every case and of the peer, in as many rounds over all of them (so that a
+        /// slow spell of the machine falls on every variant and on the peer alike); the
+        /// table gives the median run and the range, the JSON every run's throughput.
         #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
         repeat: u32,
         /// Where to write the results as JSON.
@@ -403,6 +403,25 @@ fn bench_case(
     serde_json::from_slice(&o.stdout).map_err(|e| format!("unreadable result: {e}"))
 }
 
+/// One run of a peer's script at `nx` on `threads` threads to time `tf`, read from the
+/// JSON line it prints.
+fn peer_run(
+    script: &std::path::Path,
+    nx: usize,
+    threads: usize,
+    tf: f64,
+) -> Result<bench::PeerResult, String> {
+    let o = std::process::Command::new(script)
+        .args(["--nx", &nx.to_string(), "--tf", &format!("{tf}"), "--threads", &threads.to_string()])
+        .stderr(std::process::Stdio::inherit())
+        .output()
+        .map_err(|e| e.to_string())?;
+    if !o.status.success() {
+        return Err(format!("exit status {}", o.status));
+    }
+    bench::parse_peer(&String::from_utf8_lossy(&o.stdout), nx, threads, tf)
+}
+
 #[allow(clippy::too_many_arguments)]
 fn run_bench(
     nx: Vec<usize>,
@@ -424,13 +443,13 @@ fn run_bench(
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
     let exe = std::env::current_exe().expect("own executable");
-    let mut results = Vec::new();
+    let (mut results, mut peers) = (Vec::new(), Vec::new());
     for round in 1..=repeat {
+        let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
         for &n in &nx {
             for v in &variants {
                 for &t in &threads {
                     let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-                    let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
                     eprint!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
                     match bench_case(&exe, v, n, t, k, kernel) {
                         Ok(r) => {
@@ -445,51 +464,40 @@ fn run_bench(
                 }
             }
         }
-    }
-    let results = bench::median_runs(results);
-    let mut peers = Vec::new();
-    if let Some(script) = &peer {
-        for &n in &nx {
-            for &t in &threads {
-                let tf = bench::peer_tf(n);
-                eprint!("peer {} nx={n} threads={t} tf={tf:.4} ... ", script.display());
-                let out = std::process::Command::new(script)
-                    .args(["--nx", &n.to_string(), "--tf", &format!("{tf}"), "--threads", &t.to_string()])
-                    .stderr(std::process::Stdio::inherit())
-                    .output();
-                let parsed = match out {
-                    Ok(o) if o.status.success() => {
-                        bench::parse_peer(&String::from_utf8_lossy(&o.stdout), n, t, tf)
-                    }
-                    Ok(o) => Err(format!("exit status {}", o.status)),
-                    Err(e) => Err(e.to_string()),
-                };
-                match parsed {
-                    Ok(mut p) => {
-                        eprint!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
-                        match edac_l1(&exe, n, t, p.end_time(), kernel) {
-                            Ok(l1) => {
-                                p.sphrepro_l1_velocity_final = Some(l1);
-                                let peer =
-                                    p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
-                                eprintln!(
-                                    "; L1 at t = {:.4}: peer {peer}, edac {:.2} %",
-                                    p.end_time(),
-                                    100.0 * l1
-                                );
-                            }
-                            Err(e) => {
-                                eprintln!("\nerror: edac on the peer's run: {e}");
-                                return ExitCode::from(1);
-                            }
+        // The peer in the same round, so that a slow spell falls on both codes alike.
+        if let Some(script) = &peer {
+            for &n in &nx {
+                for &t in &threads {
+                    let tf = bench::peer_tf(n);
+                    eprint!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
+                    match peer_run(script, n, t, tf) {
+                        Ok(p) => {
+                            eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                            peers.push(p);
                         }
-                        peers.push(p);
-                    }
-                    Err(e) => {
-                        eprintln!("error: peer {}: {e}", script.display());
-                        return ExitCode::from(1);
+                        Err(e) => {
+                            eprintln!("error: peer {}: {e}", script.display());
+                            return ExitCode::from(1);
+                        }
                     }
                 }
+            }
+        }
+    }
+    let results = bench::median_runs(results);
+    let mut peers = bench::median_runs(peers);
+    for p in &mut peers {
+        let (n, t) = (p.nx, p.threads);
+        eprint!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
+        match edac_l1(&exe, n, t, p.end_time(), kernel) {
+            Ok(l1) => {
+                p.sphrepro_l1_velocity_final = Some(l1);
+                let peer = p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
+                eprintln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
+            }
+            Err(e) => {
+                eprintln!("\nerror: edac on the peer's run: {e}");
+                return ExitCode::from(1);
             }
         }
     }

@@ -247,29 +247,47 @@ fn bench_measures_a_peer_in_the_same_sitting() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--kernel spline9"));
 }
 
-/// `bench --repeat 3`: each configuration once in the results, with its three runs, and the
-/// reported run is the median of them; `--repeat 0` is refused.
+/// `bench --repeat 3`: each configuration once in the results, ours and the peer's, with
+/// its three runs, and the reported run is the median of them; `--repeat 0` is refused.
 #[test]
 fn bench_repeats_every_case_and_reports_the_median_run() {
+    use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
+    // A peer whose k-th call reports k x 0.1 M particle-steps/s.
+    let (count, peer) = (dir.path().join("calls"), dir.path().join("peer.sh"));
+    let body = format!(
+        "#!/bin/sh\necho x >> {c}\nk=$(wc -l < {c})\necho \"{{\\\"particle_steps_per_second\\\": ${{k}}00000.0}}\"\n",
+        c = count.display()
+    );
+    std::fs::write(&peer, body).unwrap();
+    std::fs::set_permissions(&peer, std::fs::Permissions::from_mode(0o755)).unwrap();
     let json = dir.path().join("bench.json");
     let bin = env!("CARGO_BIN_EXE_sphrepro");
     let out = Command::new(bin)
         .args(["bench", "--nx", "20", "--bench-threads", "1,2", "--variants", "edac", "--steps", "5"])
-        .args(["--repeat", "3", "--json", json.to_str().unwrap()])
+        .args(["--repeat", "3", "--json", json.to_str().unwrap(), "--peer", peer.to_str().unwrap()])
         .output()
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert_eq!(String::from_utf8_lossy(&out.stderr).matches("(run 3 of 3)").count(), 2);
+    assert_eq!(String::from_utf8_lossy(&out.stderr).matches("(run 3 of 3)").count(), 4);
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let results = v.as_array().unwrap();
+    let runs = |r: &serde_json::Value| -> Vec<f64> {
+        r["runs"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect()
+    };
+    let results = v["results"].as_array().unwrap();
     assert_eq!(results.len(), 2);
     for r in results {
-        let mut runs: Vec<f64> = r["runs"].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()).collect();
+        let mut runs = runs(r);
         assert_eq!(runs.len(), 3);
         runs.sort_by(f64::total_cmp);
         assert_eq!(r["particle_steps_per_second"].as_f64().unwrap(), runs[1]);
     }
+    // The peer ran after our cases in each round: calls 1, 3, 5 on one thread, 2, 4, 6 on two.
+    let peers = v["peers"].as_array().unwrap();
+    assert_eq!(runs(&peers[0]), [1.0e5, 3.0e5, 5.0e5]);
+    assert_eq!(runs(&peers[1]), [2.0e5, 4.0e5, 6.0e5]);
+    assert_eq!(peers[0]["particle_steps_per_second"], 3.0e5);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("| 0.400 (0.200-0.600) |"));
     let out = Command::new(bin).args(["bench", "--repeat", "0"]).output().unwrap();
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--repeat"));
