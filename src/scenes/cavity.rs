@@ -16,8 +16,8 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim,
-    scheme_params, shepard, snapshot_bodies, wall_density, wall_from, wall_params, wall_pressure,
-    FluidConstants,
+    scheme_params, shepard, shifting_columns, snapshot_bodies, wall_density, wall_from, wall_params,
+    wall_pressure, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -204,7 +204,9 @@ impl SceneRun for Cavity {
         self.energy.push((self.sim.time(), ke));
         let rho_min = self.sim.fluid().rho.iter().fold(f64::INFINITY, |m, &r| m.min(r));
         self.min_density = self.min_density.min(rho_min / RHO0);
-        vec![("t", self.sim.time()), ("kinetic_energy", ke), ("u_max", self.sim.max_speed())]
+        let mut row = vec![("t", self.sim.time()), ("kinetic_energy", ke), ("u_max", self.sim.max_speed())];
+        row.extend(shifting_columns(&self.sim));
+        row
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         let files = snapshot_bodies(&self.sim, dir, index, Vec::new())?;

@@ -261,9 +261,7 @@ fn pad<const D: usize>(v: &Vector<D>) -> [f64; 3] {
     std::array::from_fn(|k| if k < D { v[k] } else { 0.0 })
 }
 
-/// Writes a fluid snapshot with velocity, speed, pressure, density, id, and where the
-/// scheme moves the particles with a transport velocity u~ (CTVF eq. 33), u~ and the
-/// shifting speed |u~ - u| (what the shifting adds to the flow), then the `extra` fields.
+/// Writes a fluid snapshot with velocity, speed, pressure, density, id and `extra` fields.
 pub fn write_fluid<const D: usize>(path: &Path, f: &Fluid<D>, extra: Vec<Field>) -> std::io::Result<()> {
     let mut fields = vec![
         Field::Vector("velocity", f.u.iter().map(pad).collect()),
@@ -272,15 +270,28 @@ pub fn write_fluid<const D: usize>(path: &Path, f: &Fluid<D>, extra: Vec<Field>)
         Field::Scalar("density", f.rho.clone()),
         Field::Int("id", f.id.iter().map(|&i| i as i64).collect()),
     ];
-    if let Some(u_hat) = &f.u_hat {
-        fields.push(Field::Vector("transport_velocity", u_hat.iter().map(pad).collect()));
-        fields.push(Field::Scalar(
-            "shift_speed",
-            u_hat.iter().zip(&f.u).map(|(t, u)| (t - u).norm()).collect(),
-        ));
-    }
     fields.extend(extra);
     write_vtu(path, &f.x.iter().map(pad).collect::<Vec<_>>(), &fields)
+}
+
+/// The shifting's time-series columns, every scene alike: IPST's moves in the last step
+/// (0 without IPST) and the largest shifting speed |u~ - u| (0 without shifting).
+pub fn shifting_columns<const D: usize>(sim: &Simulation<D>) -> [(&'static str, f64); 2] {
+    let shift_max = sim.shift_speeds().map_or(0.0, |s| s.into_iter().fold(0.0, f64::max));
+    [("ipst_iterations", sim.last_ipst_iterations() as f64), ("shift_max", shift_max)]
+}
+
+/// Where the scheme moves the particles with a transport velocity u~ (CTVF eq. 33): u~ and
+/// the shifting speed of the coming step, |u~ - u| (see [`Simulation::shift_speeds`]), as
+/// snapshot fields; nothing otherwise.
+pub fn shifting_fields<const D: usize>(sim: &Simulation<D>) -> Vec<Field<'static>> {
+    match (&sim.fluid().u_hat, sim.shift_speeds()) {
+        (Some(u_hat), Some(shift)) => vec![
+            Field::Vector("transport_velocity", u_hat.iter().map(pad).collect()),
+            Field::Scalar("shift_speed", shift),
+        ],
+        _ => Vec::new(),
+    }
 }
 
 /// Writes a wall snapshot: prescribed velocity, extrapolated pressure and density, normal.
@@ -369,7 +380,9 @@ pub fn snapshot_bodies<const D: usize>(
     extra: Vec<Field>,
 ) -> std::io::Result<Vec<(String, String)>> {
     let name = format!("fluid_{index:05}.vtu");
-    write_fluid(&dir.join(&name), sim.fluid(), extra)?;
+    let mut fields = shifting_fields(sim);
+    fields.extend(extra);
+    write_fluid(&dir.join(&name), sim.fluid(), fields)?;
     let mut files = vec![("fluid".to_string(), name)];
     if let Some(ws) = &sim.walls {
         let name = format!("wall_{index:05}.vtu");
@@ -470,45 +483,4 @@ pub fn wall_params() -> Vec<Spec> {
         )
         .added_later(),
     ]
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// Snapshots carry u~ and |u~ - u| only for a fluid that has a transport velocity.
-    #[test]
-    fn snapshots_carry_the_transport_velocity_where_there_is_one() {
-        let dir = tempfile::tempdir().unwrap();
-        let init = || FluidInit::<2> {
-            x: vec![Vector::<2>::new(0.0, 0.0), Vector::<2>::new(1.0, 0.0)],
-            u: vec![Vector::<2>::new(1.0, 0.0); 2],
-            m: vec![1.0; 2],
-            rho: vec![1.0; 2],
-            p: vec![0.0; 2],
-        };
-        let mut f = Fluid::new("fluid", 1.0, init(), true).unwrap();
-        f.u_hat.as_mut().unwrap()[1] = Vector::<2>::new(1.0, 0.25);
-        let path = dir.path().join("with.vtu");
-        write_fluid(&path, &f, Vec::new()).unwrap();
-        let vtu = std::fs::read_to_string(&path).unwrap();
-        assert!(vtu.contains("Name=\"transport_velocity\""), "{vtu}");
-        let shift = vtu.split("Name=\"shift_speed\"").nth(1).unwrap();
-        let values: Vec<f64> = shift
-            .split('>')
-            .nth(1)
-            .unwrap()
-            .split('<')
-            .next()
-            .unwrap()
-            .split_whitespace()
-            .map(|v| v.parse().unwrap())
-            .collect();
-        assert_eq!(values, [0.0, 0.25]);
-        let f = Fluid::new("fluid", 1.0, init(), false).unwrap();
-        let path = dir.path().join("without.vtu");
-        write_fluid(&path, &f, Vec::new()).unwrap();
-        let vtu = std::fs::read_to_string(&path).unwrap();
-        assert!(!vtu.contains("transport_velocity") && !vtu.contains("shift_speed"));
-    }
 }

@@ -12,13 +12,14 @@
 //! time range (our toe interpolated at their times); `particles_lost`, fluid particles
 //! outside the tank at the end (through a wall beyond its outer layer, or thrown over it);
 //! `max_penetration`, the deepest fluid particle beyond a wall surface but within its
-//! layers, in dx. `timeseries.csv`: `t, toe, t_star, toe_star, max_speed`, with the toe Z
+//! layers, in dx. `timeseries.csv`: `t, toe, t_star, toe_star, max_speed, ipst_iterations,
+//! shift_max` (the shifting columns of every scene), with the toe Z
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
-    wall_params, wall_pressure, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies, wall_density,
+    wall_from, wall_params, wall_pressure, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
@@ -183,7 +184,15 @@ impl SceneRun for DamBreak {
         let (t, toe) = (self.sim.time(), self.toe());
         let (ts, zs) = (self.t_star(t), toe / self.column_width);
         self.toe.push((ts, zs));
-        vec![("t", t), ("toe", toe), ("t_star", ts), ("toe_star", zs), ("max_speed", self.sim.max_speed())]
+        let mut row = vec![
+            ("t", t),
+            ("toe", toe),
+            ("t_star", ts),
+            ("toe_star", zs),
+            ("max_speed", self.sim.max_speed()),
+        ];
+        row.extend(shifting_columns(&self.sim));
+        row
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))

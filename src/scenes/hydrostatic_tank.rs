@@ -11,8 +11,8 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, snapshot_bodies, wall_density, wall_from,
-    wall_params, wall_pressure, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies, wall_density,
+    wall_from, wall_params, wall_pressure, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -123,7 +123,9 @@ impl SceneRun for Tank {
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (p_err, umax) = self.errors();
-        vec![("t", self.sim.time()), ("max_speed", umax), ("pressure_rel_error", p_err)]
+        let mut row = vec![("t", self.sim.time()), ("max_speed", umax), ("pressure_rel_error", p_err)];
+        row.extend(shifting_columns(&self.sim));
+        row
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, Vec::new())

@@ -20,8 +20,8 @@
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
 use super::common::{
-    check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, snapshot_bodies,
-    FluidConstants,
+    check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, shifting_columns,
+    snapshot_bodies, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -300,14 +300,6 @@ impl<const D: usize> TaylorGreen<D> {
     }
 }
 
-impl<const D: usize> TaylorGreen<D> {
-    /// Largest |u~ - u|: how fast the shifting moves particles relative to the flow.
-    fn shift_max(&self) -> f64 {
-        let f = self.sim.fluid();
-        f.u_hat().iter().zip(&f.u).map(|(a, b)| (a - b).norm()).fold(0.0, f64::max)
-    }
-}
-
 impl<const D: usize> SceneRun for TaylorGreen<D> {
     forward_to_sim!();
     fn plan(&self) -> String {
@@ -323,7 +315,7 @@ impl<const D: usize> SceneRun for TaylorGreen<D> {
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let e = self.errors();
         self.l1 = self.l1.with(self.sim.time(), e.l1);
-        vec![
+        let mut row = vec![
             ("t", self.sim.time()),
             ("u_max", e.u_max),
             ("u_max_exact", e.u_max_exact),
@@ -332,9 +324,9 @@ impl<const D: usize> SceneRun for TaylorGreen<D> {
             ("p_l1", e.p_l1),
             ("kinetic_energy", e.ke),
             ("kinetic_energy_exact", e.ke_exact),
-            ("ipst_iterations", self.sim.last_ipst_iterations() as f64),
-            ("shift_max", self.shift_max()),
-        ]
+        ];
+        row.extend(shifting_columns(&self.sim));
+        row
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         let f = self.sim.fluid();

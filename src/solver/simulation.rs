@@ -249,6 +249,16 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
+    /// Each fluid particle's shifting speed in the coming step, |u~ - u| = dt/2 |(du/dt)_c|
+    /// (eq. 55, dt the nominal step of eq. 61): how fast the shifting moves it relative to
+    /// the flow; `None` without a transport velocity. (The stored u~ is of the last half
+    /// step and u of the full step, so their difference also holds dt/2 du/dt.)
+    pub fn shift_speeds(&self) -> Option<Vec<f64>> {
+        self.state.fluid.u_hat.as_ref()?;
+        let half_dt = 0.5 * self.nominal_dt();
+        Some(self.state.rates.a_c.iter().map(|a| half_dt * a.norm()).collect())
+    }
+
     /// The time step of eq. (61) from the current largest speed.
     pub fn nominal_dt(&self) -> f64 {
         let s = &self.state.scheme;
