@@ -135,12 +135,11 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             std::fs::File::create(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
         }
     }
-    let mut ts = csv::Writer::from_writer(
-        std::fs::OpenOptions::new()
-            .append(true)
-            .open(&ts_path)
-            .map_err(|e| RunError::Input(io_err(&ts_path, e)))?,
-    );
+    let append =
+        |path: &Path| std::fs::OpenOptions::new().append(true).open(path).map(csv::Writer::from_writer);
+    let mut ts = append(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
+    // The columns of the rows written before a resume: a later build may sample others.
+    let mut resumed_columns = (ts_rows > 0).then(|| header(&ts_path)).flatten();
 
     let bar = progress_bar(opts.quiet);
     let mut progress_file = ProgressFile::new(opts.progress_file.clone());
@@ -152,6 +151,15 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let at_end = t >= tf - eps;
         if t >= next_sample - eps || at_end {
             let row = scene.sample();
+            let keys: Vec<&str> = row.iter().map(|(k, _)| *k).collect();
+            if resumed_columns.take().is_some_and(|old| old != keys) {
+                let realigned =
+                    ts.flush().and_then(|_| realign_columns(&ts_path, &keys)).and_then(|_| append(&ts_path));
+                match realigned {
+                    Ok(w) => ts = w,
+                    Err(e) => break Outcome::Failed(io_err(&ts_path, e)),
+                }
+            }
             let written = (|| -> csv::Result<()> {
                 if ts_rows == 0 {
                     ts.write_record(row.iter().map(|(k, _)| *k))?;
@@ -323,6 +331,29 @@ fn read_checkpoint(path: &Path, params: &Params) -> Option<Checkpoint> {
     (c.params == *params).then_some(c)
 }
 
+/// The column names of a CSV file's header, if it has one.
+fn header(path: &Path) -> Option<Vec<String>> {
+    let text = std::fs::read_to_string(path).ok()?;
+    Some(text.lines().next()?.split(',').map(str::to_string).collect())
+}
+
+/// Rewrites a time series under the header `keys`, for a run resumed by a build that samples
+/// other columns: each row keeps its values under their names, `NaN` where a column is new
+/// (a column no longer sampled is dropped), so that every row has the header's width.
+fn realign_columns(path: &Path, keys: &[&str]) -> std::io::Result<()> {
+    let text = std::fs::read_to_string(path)?;
+    let mut lines = text.lines();
+    let old: Vec<&str> = lines.next().unwrap_or_default().split(',').collect();
+    let mut out = keys.join(",") + "\n";
+    for line in lines {
+        let values: Vec<&str> = line.split(',').collect();
+        let value = |k: &&str| old.iter().position(|o| o == k).and_then(|i| values.get(i)).copied();
+        out += &keys.iter().map(|k| value(k).unwrap_or("NaN")).collect::<Vec<_>>().join(",");
+        out.push('\n');
+    }
+    crate::solver::output::write_atomic(path, out.as_bytes())
+}
+
 /// Keeps the header and the first `rows` rows of a CSV file.
 fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
     let text = std::fs::read_to_string(path).unwrap_or_default();
@@ -366,5 +397,24 @@ impl ProgressFile {
         if let Ok(mut f) = std::fs::File::create(p) {
             let _ = writeln!(f, "{time} {tf} {steps}");
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rows written by an older build keep their values under their column names; a column
+    /// new to this build reads NaN, one it no longer samples is dropped.
+    #[test]
+    fn a_resumed_time_series_takes_the_new_columns() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("timeseries.csv");
+        std::fs::write(&path, "t,u_max,old\n0e0,1e0,7e0\n1e-1,2e0,8e0\n").unwrap();
+        assert_eq!(header(&path).unwrap(), ["t", "u_max", "old"]);
+        realign_columns(&path, &["t", "u_max", "shift_max"]).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(text, "t,u_max,shift_max\n0e0,1e0,NaN\n1e-1,2e0,NaN\n");
+        assert!(text.lines().nth(1).unwrap().split(',').all(|v| v.parse::<f64>().is_ok()));
     }
 }
