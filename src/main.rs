@@ -80,6 +80,42 @@ impl RunArgs {
     }
 }
 
+/// `sphrepro bench`.
+#[derive(Args)]
+struct BenchArgs {
+    /// Resolutions (particles per side).
+    #[arg(long, value_delimiter = ',', default_values_t = vec![50usize, 100, 200, 400])]
+    nx: Vec<usize>,
+    /// Thread counts.
+    #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2])]
+    bench_threads: Vec<usize>,
+    /// Variants (edac, ctvf+sun, ctvf+ipst).
+    #[arg(long, value_delimiter = ',')]
+    variants: Option<Vec<String>>,
+    /// Timed steps per case (default: about 4 million particle-steps).
+    #[arg(long)]
+    steps: Option<u64>,
+    /// Runs of every case and of the peer, in as many rounds over all of them (so that a
+    /// slow spell of the machine falls on every variant and on the peer alike); the
+    /// table gives the median run and the range, the JSON every run's throughput.
+    #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    repeat: u32,
+    /// Where to write the results as JSON.
+    #[arg(long, default_value = "output/bench.json")]
+    json: PathBuf,
+    /// A peer code's runner to measure in the same sitting, e.g.
+    /// `../shared/peers/pysph-taylor-green.sh`: called with `--nx N --tf T --threads K`
+    /// for every resolution and thread count, it must print one JSON line with
+    /// `particle_steps_per_second`; the table then gives our ratio to it at each size
+    /// and, when nx = 50 is among the resolutions, to its nx = 50 run (the issue's
+    /// figure to beat).
+    #[arg(long)]
+    peer: Option<PathBuf>,
+    /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
+    #[arg(long, default_value = bench::DEFAULT_KERNEL)]
+    kernel: String,
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// List the problems and their cases, then the scenes and their parameters.
@@ -151,39 +187,7 @@ enum Command {
         stop_after_steps: Option<u64>,
     },
     /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
-    Bench {
-        /// Resolutions (particles per side).
-        #[arg(long, value_delimiter = ',', default_values_t = vec![50usize, 100, 200, 400])]
-        nx: Vec<usize>,
-        /// Thread counts.
-        #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2])]
-        bench_threads: Vec<usize>,
-        /// Variants (edac, ctvf+sun, ctvf+ipst).
-        #[arg(long, value_delimiter = ',')]
-        variants: Option<Vec<String>>,
-        /// Timed steps per case (default: about 4 million particle-steps).
-        #[arg(long)]
-        steps: Option<u64>,
-        /// Runs of every case and of the peer, in as many rounds over all of them (so that a
-        /// slow spell of the machine falls on every variant and on the peer alike); the
-        /// table gives the median run and the range, the JSON every run's throughput.
-        #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
-        repeat: u32,
-        /// Where to write the results as JSON.
-        #[arg(long, default_value = "output/bench.json")]
-        json: PathBuf,
-        /// A peer code's runner to measure in the same sitting, e.g.
-        /// `../shared/peers/pysph-taylor-green.sh`: called with `--nx N --tf T --threads K`
-        /// for every resolution and thread count, it must print one JSON line with
-        /// `particle_steps_per_second`; the table then gives our ratio to it at each size
-        /// and, when nx = 50 is among the resolutions, to its nx = 50 run (the issue's
-        /// figure to beat).
-        #[arg(long)]
-        peer: Option<PathBuf>,
-        /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
-        #[arg(long, default_value = bench::DEFAULT_KERNEL)]
-        kernel: String,
-    },
+    Bench(BenchArgs),
     /// One benchmark configuration in this process (used by `bench`).
     #[command(hide = true)]
     BenchCase {
@@ -319,9 +323,7 @@ fn run(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Bench { nx, bench_threads, variants, steps, repeat, json, peer, kernel } => {
-            run_bench(nx, bench_threads, variants, steps, repeat, json, peer, &kernel)
-        }
+        Command::Bench(args) => run_bench(args),
         Command::BenchCase { variant, nx, steps, kernel } => {
             match bench::run_case(&variant, nx, steps, 5, &kernel) {
                 Ok(r) => {
@@ -422,17 +424,9 @@ fn peer_run(
     bench::parse_peer(&String::from_utf8_lossy(&o.stdout), nx, threads, tf)
 }
 
-#[allow(clippy::too_many_arguments)]
-fn run_bench(
-    nx: Vec<usize>,
-    threads: Vec<usize>,
-    variants: Option<Vec<String>>,
-    steps: Option<u64>,
-    repeat: u32,
-    json: PathBuf,
-    peer: Option<PathBuf>,
-    kernel: &str,
-) -> ExitCode {
+fn run_bench(args: BenchArgs) -> ExitCode {
+    let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel } = args;
+    let kernel = kernel.as_str();
     if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
         eprintln!(
             "error: bench: --kernel {kernel}: expected one of {}",
