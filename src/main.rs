@@ -232,14 +232,17 @@ fn run(cli: Cli) -> ExitCode {
             println!("scenes:");
             for s in scenes::SCENES {
                 println!("{} ({}D): {}", s.name, s.dim, s.about);
-                for p in (s.params)() {
-                    println!(
-                        "    {:<16} {:<28} default {:<14} {}",
-                        p.name,
-                        p.kind_name(),
-                        p.default.to_string(),
-                        p.help
-                    );
+                let params = (s.params)();
+                // Columns as wide as the scene's widest entry, so that long names and
+                // choice lists keep the help text aligned.
+                let rows: Vec<[String; 4]> = params
+                    .iter()
+                    .map(|p| [p.name.to_string(), p.kind_name(), p.default.to_string(), p.help.to_string()])
+                    .collect();
+                let width = |c: usize| rows.iter().map(|r| r[c].len()).max().unwrap_or(0);
+                let (w0, w1, w2) = (width(0), width(1), width(2));
+                for [name, kind, default, help] in &rows {
+                    println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
                 }
                 println!("    metrics: {}", s.metrics.join(", "));
             }
