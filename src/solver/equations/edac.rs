@@ -31,10 +31,12 @@ pub fn transport_correction<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pai
 /// `nu_edac lap(p)`: the pressure diffusion of eq. (26), in the Morris form
 /// `V_b 2 nu (p_a - p_b) x_ab . grad W / (r^2 + 0.01 h^2)`.
 ///
-/// Eq. (26) prints the factor `4 / (rho_a + rho_b)`, which is 2 at unit density (every
-/// benchmark of the paper that uses it: Taylor-Green, cavity) but gives the term units of
-/// pressure per density otherwise; the continuous term `nu lap(p)` has the factor 2, which
-/// is what PySPH's `EDACEquation` computes. We use 2.
+/// Eq. (26) prints the factor `4 / (rho_a + rho_b)`, which is 2 at unit density (the
+/// Taylor-Green vortex and the cavity) but gives the term units of pressure per density
+/// otherwise; the continuous term `nu lap(p)` has the factor 2, which is what PySPH's
+/// `EDACEquation` computes. We use 2. Where rho0 is not 1 (the dam break and the tank,
+/// rho0 = 1000) this diffuses pressure rho0 = 1000 times more than the printed factor,
+/// which the authors' code keeps.
 #[inline(always)]
 pub fn diffusion<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, nu: f64) -> f64 {
     b.v() * 2.0 * nu * (a.p - b.p) * ab.xij.dot(&ab.dwij) * ab.inv_r2_eps

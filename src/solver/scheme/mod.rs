@@ -264,16 +264,19 @@ pub struct Transport {
     pub corrections: Corrections,
 }
 
-/// The paper's values of the scheme constants a scene may override (`--set`): alpha_edac of
-/// eq. (24), and IPST's tolerance of eq. (39) and iteration cap, on every step (sec. 3.3.2).
+/// Defaults of the scheme constants a scene may override (`--set`). The paper gives alpha_edac
+/// (eq. 24) and IPST on every step (sec. 3.3.2); it names IPST's tolerance (eq. 39) but gives
+/// no value, nor an iteration cap, so those two come from the authors' public code.
 pub mod paper {
-    /// alpha of nu_edac, eq. (24).
+    /// alpha of nu_edac, eq. (24): the paper's 0.5.
     pub const EDAC_ALPHA: f64 = 0.5;
-    /// IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39).
+    /// IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39). The authors' internal-flow
+    /// check uses 0.02 on the absolute |max chi - chi_ref| (0.2 in their other schemes); with
+    /// chi = h^2 sum W, chi_ref is close to 1 for h = dx in 2D, where the two agree.
     pub const IPST_TOL: f64 = 0.02;
-    /// IPST moves per step at most.
+    /// IPST moves per step at most: not in the paper; the authors' code caps them at 10.
     pub const IPST_MAX_ITER: usize = 10;
-    /// IPST on every this many steps (the authors' code uses 5).
+    /// IPST on every this many steps: the paper's every step (the authors' code uses 5).
     pub const IPST_INTERVAL: usize = 1;
 }
 
