@@ -8,12 +8,29 @@ use sphrepro::scenes::{self, harness};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+/// A count that must be at least 1 (threads, jobs, resolutions, steps).
+fn at_least_one<T: std::str::FromStr + PartialOrd + From<u8>>(s: &str) -> Result<T, String> {
+    match s.parse::<T>() {
+        Ok(n) if n >= T::from(1) => Ok(n),
+        _ => Err(format!("`{s}` is not a whole number of at least 1")),
+    }
+}
+
+/// A finite, positive number of seconds.
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x.is_finite() && x > 0.0 => Ok(x),
+        Ok(_) => Err(format!("`{s}` is not a positive number of seconds")),
+        Err(e) => Err(format!("`{s}`: {e}")),
+    }
+}
+
 /// Reproduce SPH papers with one command.
 #[derive(Parser)]
 #[command(name = "sphrepro", version, about)]
 struct Cli {
     /// Rayon threads (default: all cores, or RAYON_NUM_THREADS).
-    #[arg(long, global = true)]
+    #[arg(long, global = true, value_parser = at_least_one::<usize>)]
     threads: Option<usize>,
     #[command(subcommand)]
     command: Command,
@@ -56,7 +73,7 @@ struct RunArgs {
     #[arg(long)]
     force: bool,
     /// Concurrent cases (default: the core count; cores are split between cases and threads).
-    #[arg(long)]
+    #[arg(long, value_parser = at_least_one::<usize>)]
     jobs: Option<usize>,
     /// Print what would run and why; run nothing.
     #[arg(long)]
@@ -84,16 +101,16 @@ impl RunArgs {
 #[derive(Args)]
 struct BenchArgs {
     /// Resolutions (particles per side).
-    #[arg(long, value_delimiter = ',', default_values_t = vec![50usize, 100, 200, 400])]
+    #[arg(long, value_delimiter = ',', default_values_t = vec![50usize, 100, 200, 400], value_parser = at_least_one::<usize>)]
     nx: Vec<usize>,
     /// Thread counts.
-    #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2])]
+    #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2], value_parser = at_least_one::<usize>)]
     bench_threads: Vec<usize>,
     /// Variants (edac, ctvf+sun, ctvf+ipst).
     #[arg(long, value_delimiter = ',')]
     variants: Option<Vec<String>>,
     /// Timed steps per case (default: about 4 million particle-steps).
-    #[arg(long)]
+    #[arg(long, value_parser = at_least_one::<u64>)]
     steps: Option<u64>,
     /// Runs of every case and of the peer, in as many rounds over all of them (so that a
     /// slow spell of the machine falls on every variant and on the peer alike); the
@@ -172,7 +189,8 @@ enum Command {
         /// No progress bar or plan on stderr.
         #[arg(long)]
         quiet: bool,
-        /// Overwrite a finished run in the output folder.
+        /// Overwrite a finished run in the output folder, or discard an interrupted run of other
+        /// parameters there.
         #[arg(long)]
         force: bool,
         /// Write `time tf steps` to this file about twice a second.
@@ -180,7 +198,7 @@ enum Command {
         progress_file: Option<PathBuf>,
         /// Write DIR/checkpoint.json every SECONDS of stepping (and on Ctrl-C); a run of
         /// the same case into the same folder resumes from it.
-        #[arg(long, value_name = "SECONDS")]
+        #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
         checkpoint_every: Option<f64>,
         /// Stop after N steps as if interrupted, checkpointing first (tests the resume path).
         #[arg(long, hide = true)]
@@ -439,9 +457,22 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     }
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
+    // Every argument is checked before the first case runs, so that a typo costs no sitting.
+    if let Some(v) = variants.iter().find(|v| !bench::VARIANTS.iter().any(|k| k.0 == v.as_str())) {
+        let known: Vec<&str> = bench::VARIANTS.iter().map(|k| k.0).collect();
+        eprintln!("error: bench: --variants {v}: expected one of {}", known.join(", "));
+        return ExitCode::from(2);
+    }
+    if let Some(script) = peer.as_ref().filter(|p| !p.is_file()) {
+        eprintln!("error: bench: --peer {}: no such file", script.display());
+        return ExitCode::from(2);
+    }
     let exe = std::env::current_exe().expect("own executable");
     let (mut results, mut peers) = (Vec::new(), Vec::new());
-    for round in 1..=repeat {
+    // A case or a peer run that fails ends the sitting, but what was measured before it is
+    // still reported and written.
+    let mut failure: Option<String> = None;
+    'rounds: for round in 1..=repeat {
         let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
         for &n in &nx {
             for v in &variants {
@@ -455,7 +486,8 @@ fn run_bench(args: BenchArgs) -> ExitCode {
                         }
                         Err(e) => {
                             eprintln!("{e}");
-                            return ExitCode::from(1);
+                            failure = Some(format!("bench {v} nx={n} threads={t}: {e}"));
+                            break 'rounds;
                         }
                     }
                 }
@@ -474,7 +506,8 @@ fn run_bench(args: BenchArgs) -> ExitCode {
                         }
                         Err(e) => {
                             eprintln!("error: peer {}: {e}", script.display());
-                            return ExitCode::from(1);
+                            failure = Some(format!("peer {} nx={n} threads={t}: {e}", script.display()));
+                            break 'rounds;
                         }
                     }
                 }
@@ -494,7 +527,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
             Err(e) => {
                 eprintln!("\nerror: edac on the peer's run: {e}");
-                return ExitCode::from(1);
+                failure.get_or_insert(format!("edac on the peer's run nx={n} threads={t}: {e}"));
             }
         }
     }
@@ -517,5 +550,11 @@ fn run_bench(args: BenchArgs) -> ExitCode {
         return ExitCode::from(1);
     }
     eprintln!("wrote {}", json.display());
-    ExitCode::SUCCESS
+    match failure {
+        Some(e) => {
+            eprintln!("error: the sitting stopped early (the table and the JSON hold what ran before): {e}");
+            ExitCode::from(1)
+        }
+        None => ExitCode::SUCCESS,
+    }
 }

@@ -234,6 +234,13 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
         ("duplicate case", "name = \"b\"", "name = \"a-nx12\"", "two cases"),
         ("missing case", "cases = [\"a-*\"]", "cases = [\"zz\"]", "zz"),
         ("missing metric", "metric = \"l1_velocity_final\"", "metric = \"l7\"", "l7"),
+        ("missing column", "y = \"u_max\"", "y = \"u_maxx\"", "no time-series column `u_maxx`"),
+        (
+            "bound that no value can hold",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[bounds]]\nmetric = \"l1_velocity_final\"\ncases = [\"b\"]\nmin = 0.5\nmax = 0.1\n",
+            "min = 0.5 is above max = 0.1",
+        ),
         // Valid alone, refused by the scene before anything runs (named by case, not line).
         (
             "support reaching no neighbour",
@@ -258,13 +265,32 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
             t.contains(&format!("tiny.toml:{line}"))
                 || *what == "missing case"
                 || *what == "missing metric"
+                || *what == "missing column"
                 || *what == "duplicate case"
+                || *what == "bound that no value can hold"
                 || *what == "support reaching no neighbour",
             "{what}: no line {line} in: {t}"
         );
         assert!(t.contains("tiny.toml:"), "{what}: no file in {t}");
         assert!(!env.root.join("output").exists(), "{what}: wrote output");
         assert!(!t.contains("panicked"), "{what}: {t}");
+    }
+}
+
+/// Options that select nothing or make no sense are refused before anything runs.
+#[test]
+fn a_match_that_selects_nothing_and_zero_counts_are_refused() {
+    let env = Env::new(VALID);
+    for (args, word) in [
+        (&["run", "tiny", "--match", "zzz*"][..], "zzz*"),
+        (&["run", "tiny", "--jobs", "0"][..], "--jobs"),
+        (&["--threads", "0", "run", "tiny"][..], "--threads"),
+    ] {
+        let o = env.run(args);
+        let t = text(&o);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {t}");
+        assert!(t.contains(word), "{args:?}: no `{word}` in {t}");
+        assert!(!env.root.join("output").exists(), "{args:?}: wrote output");
     }
 }
 

@@ -51,6 +51,10 @@ fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
         ("taylor_green_3d", &["nz=4"], &["nz", "4"]),
         ("taylor_green_3d", &["nz=0"], &["nz", "0"]),
         ("no_such_scene", &[], &["no_such_scene"]),
+        // Accepted as > 0, but its viscous time step would need 2.6e30 steps: refused at
+        // once rather than stepping forever.
+        ("taylor_green", &["re=1e-30", "tf=0.01"], &["re", "steps"]),
+        ("taylor_green", &["nx=8", "nx=10"], &["nx=8", "nx=10", "twice"]),
     ];
     for (scene, sets, words) in cases {
         let dir = tempfile::tempdir().unwrap();
@@ -86,6 +90,21 @@ fn a_blow_up_ends_diverged_with_a_reason_and_a_non_zero_exit() {
     assert_eq!(t, s["final_time"].as_f64().unwrap(), "{last}");
     let file = last.split("file=\"").nth(1).unwrap().split('"').next().unwrap();
     assert!(dir.path().join(file).exists(), "{file}");
+}
+
+/// `edac` at cfl = 5 on an 8x8 lattice stays finite and inside its periodic box, but its
+/// speed grows to 30-45 U; a run at Mach > 1 has left the weakly compressible model and must
+/// not report `completed`.
+#[test]
+fn a_run_that_grows_without_turning_nan_ends_diverged_at_mach_one() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=8", "scheme=edac", "cfl=5", "tf=1.0"]);
+    assert_eq!(code, 3, "stderr: {err}");
+    let s: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    assert_eq!(s["status"], "diverged");
+    let reason = s["reason"].as_str().unwrap();
+    assert!(reason.contains("exceeds 1 c0"), "{reason}");
 }
 
 #[test]

@@ -99,6 +99,7 @@ static STUBS: &[SceneEntry] = &[
         build: unbuildable,
         check: |_| Ok(()),
         metrics: &["ghia_u_rms", "ghia_u_max", "ghia_v_rms", "ghia_v_max", "kinetic_energy_change"],
+        columns: sphrepro::scenes::cavity::ENTRY.columns,
         outputs: 0,
     },
     SceneEntry {
@@ -109,6 +110,7 @@ static STUBS: &[SceneEntry] = &[
         build: unbuildable,
         check: |_| Ok(()),
         metrics: &["pressure_rel_error", "max_speed"],
+        columns: sphrepro::scenes::hydrostatic_tank::ENTRY.columns,
         outputs: 0,
     },
     SceneEntry {
@@ -119,6 +121,7 @@ static STUBS: &[SceneEntry] = &[
         build: unbuildable,
         check: |_| Ok(()),
         metrics: &["toe_rms", "particles_lost", "max_penetration"],
+        columns: sphrepro::scenes::dam_break::ENTRY.columns,
         outputs: 0,
     },
     SceneEntry {
@@ -129,6 +132,7 @@ static STUBS: &[SceneEntry] = &[
         build: unbuildable,
         check: |_| Ok(()),
         metrics: &["surface_particles", "interior_surface_particles"],
+        columns: sphrepro::scenes::free_surface_demo::ENTRY.columns,
         outputs: 0,
     },
 ];

@@ -7,6 +7,7 @@
 
 use sphrepro::scenes::harness::{self, RunOptions};
 use sphrepro::scenes::taylor_green;
+use sphrepro::solver::output::summary::Status;
 use std::collections::BTreeMap;
 
 fn run(sets: &[&str]) -> BTreeMap<String, f64> {
@@ -138,6 +139,27 @@ fn a_resumed_run_equals_an_uninterrupted_one() {
         assert!(same, "{f} differs between the resumed and the uninterrupted run");
     }
     assert!(!b.path().join("checkpoint.json").exists(), "a finished run leaves no checkpoint");
+}
+
+/// An interrupted run's checkpoint is work a user computed: a run of other parameters in the
+/// same folder refuses to discard it unless forced.
+#[test]
+fn another_case_keeps_off_an_interrupted_run_unless_forced() {
+    let dir = tempfile::tempdir().unwrap();
+    let quiet = RunOptions { quiet: true, ..Default::default() };
+    let stop = RunOptions { quiet: true, stop_after_steps: Some(5), ..Default::default() };
+    let first = taylor_green::params_from(&["nx=16", "tf=0.1"]).unwrap();
+    assert!(harness::run(&taylor_green::ENTRY, &first, dir.path(), &stop).is_err());
+    let checkpoint = std::fs::read(dir.path().join("checkpoint.json")).unwrap();
+    let other = taylor_green::params_from(&["nx=16", "tf=0.1", "scheme=edac"]).unwrap();
+    let refused = harness::run(&taylor_green::ENTRY, &other, dir.path(), &quiet).unwrap_err();
+    assert!(refused.to_string().contains("--force"), "{refused}");
+    assert_eq!(std::fs::read(dir.path().join("checkpoint.json")).unwrap(), checkpoint, "kept as it was");
+    let forced = RunOptions { force: true, ..quiet };
+    assert_eq!(
+        harness::run(&taylor_green::ENTRY, &other, dir.path(), &forced).unwrap().status,
+        Status::Completed
+    );
 }
 
 /// `ipst_interval = 5` (the authors' code's default; the paper shifts every step): IPST moves

@@ -171,8 +171,15 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
     }
     ensure_dir(&dirs.manuscript, "manuscript")?;
     let mut sections = Vec::new();
+    let mut errors = Vec::new();
     for p in problems {
-        sections.push(super::study::regenerate(p, &dirs.output, &dirs.manuscript)?);
+        match super::study::regenerate(p, &dirs.output, &dirs.manuscript) {
+            Ok(section) => sections.push(section),
+            Err(e) => {
+                errors.push(e);
+                continue;
+            }
+        }
         println!(
             "{}: {} figure(s), {} table(s) in {}",
             p.name,
@@ -180,6 +187,11 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
             p.tables.len(),
             dirs.manuscript.display()
         );
+    }
+    // Every problem's figures were attempted; a manuscript missing a section is not written
+    // over the last whole one.
+    if !errors.is_empty() {
+        return Err(errors.join("\nerror: "));
     }
     if flags.manuscript {
         let path = dirs.manuscript.join("manuscript.md");

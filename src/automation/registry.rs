@@ -456,7 +456,10 @@ pub fn parse_with(
     let loc = Loc { path, src };
     let file: ProblemFile = toml::from_str(src).map_err(|e| {
         let line = e.span().map(|s| loc.line(s.start)).unwrap_or(1);
-        format!("{}:{line}: {}", path.display(), e.message().trim_end().replace('\n', " "))
+        // The parser names the value, not always its key: quote the line, which holds both.
+        let text = src.lines().nth(line - 1).map(str::trim).unwrap_or_default();
+        let quoted = if text.is_empty() || text.len() > 80 { String::new() } else { format!("`{text}`: ") };
+        format!("{}:{line}: {quoted}{}", path.display(), e.message().trim_end().replace('\n', " "))
     })?;
     let scene = find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
@@ -473,19 +476,17 @@ pub fn parse_with(
     if file.cases.is_empty() {
         return Err(format!("{}: no [[cases]]: a problem needs at least one", path.display()));
     }
-    // Preset variables: every preset defines the same names.
-    let first_vars: Vec<&String> = file.presets.values().next().unwrap().get_ref().keys().collect();
+    // Preset variables: every preset defines the same names; the one that lacks a name
+    // another defines is the one named.
     for (pname, vars) in &file.presets {
-        let names: Vec<&String> = vars.get_ref().keys().collect();
-        if names != first_vars {
-            return Err(loc.err(
-                vars.span(),
-                &format!("presets.{pname}"),
-                format!(
-                    "every preset must define the same variables (found {:?}, expected {:?})",
-                    names, first_vars
-                ),
-            ));
+        for (other, other_vars) in &file.presets {
+            if let Some(v) = other_vars.get_ref().keys().find(|v| !vars.get_ref().contains_key(*v)) {
+                return Err(loc.err(
+                    vars.span(),
+                    &format!("presets.{pname}"),
+                    format!("does not define `{v}`, which [presets.{other}] does: every preset defines the same variables"),
+                ));
+            }
         }
     }
     let (mut out, mut others) = (None, Vec::new());
@@ -780,7 +781,23 @@ fn expand(
             v.clone().ok_or_else(|| loc.err(span.clone(), &key, format!("kind `{}` needs `{what}`", f.kind)))
         };
         let kind = match f.kind.as_str() {
-            "timeseries" => FigureKind::Timeseries { y: need("y", &f.y)?, exact: f.exact.clone() },
+            "timeseries" => {
+                let y = need("y", &f.y)?;
+                for (what, c) in [("y", Some(&y)), ("exact", f.exact.as_ref())] {
+                    if let Some(c) = c.filter(|c| !scene.columns.contains(&c.as_str())) {
+                        return Err(loc.err(
+                            span,
+                            &format!("{key}.{what}"),
+                            format!(
+                                "scene `{}` has no time-series column `{c}`; its columns: {}",
+                                scene.name,
+                                scene.columns.join(", ")
+                            ),
+                        ));
+                    }
+                }
+                FigureKind::Timeseries { y, exact: f.exact.clone() }
+            }
             "particles" => {
                 if let Some(t) = f.time {
                     if !(t.is_finite() && t >= 0.0) {
@@ -955,6 +972,15 @@ fn expand(
         check_metric(loc, span.clone(), "bounds.metric", scene, &b.metric)?;
         if b.max.is_none() && b.min.is_none() {
             return Err(loc.err(span, &key, "a bound needs `max` or `min`"));
+        }
+        if let (Some(lo), Some(hi)) = (b.min, b.max) {
+            if lo > hi {
+                return Err(loc.err(
+                    span,
+                    &key,
+                    format!("min = {lo} is above max = {hi}: no value can hold"),
+                ));
+            }
         }
         let presets = b.presets.clone().unwrap_or_else(|| vec![DEFAULT_PRESET.to_string()]);
         for p in &presets {
@@ -1247,7 +1273,10 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         assert!(e.contains("`figures.prof`") && e.contains("needs `file`"), "{e}");
         let e = p_in(root.path(), &src.replace("y = \"y\"\nx_label", "x_label")).unwrap_err();
         assert!(e.contains("needs `y`"), "{e}");
-        let e = p_in(root.path(), &src.replace("kind = \"profile\"", "kind = \"timeseries\"")).unwrap_err();
+        let timeseries = src
+            .replace("kind = \"profile\"", "kind = \"timeseries\"")
+            .replace("y = \"y\"\nx_label", "y = \"u_max\"\nx_label");
+        let e = p_in(root.path(), &timeseries).unwrap_err();
         assert!(e.contains("only kind `profile`"), "{e}");
     }
 }

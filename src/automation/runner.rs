@@ -63,7 +63,7 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
         None => None,
     };
     let mut tasks = Vec::new();
-    let mut done = 0;
+    let (mut done, mut matched) = (0, 0);
     for p in problems {
         for e in super::cache::entries(output, p) {
             if let Some(m) = &matcher {
@@ -71,6 +71,7 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
                     continue;
                 }
             }
+            matched += 1;
             let reason = match e.state() {
                 State::Done(_) if opts.force => "forced".to_string(),
                 State::Done(_) => {
@@ -86,6 +87,10 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
             };
             tasks.push(Task { problem: p.name.clone(), entry: e, reason });
         }
+    }
+    // A pattern that selects nothing is a typo, not a request to run nothing.
+    if let (Some(g), 0) = (&opts.matching, matched) {
+        return Err(format!("--match `{g}`: no case of the selected problems matches it"));
     }
     Ok((tasks, done))
 }

@@ -193,12 +193,24 @@ fn snapshot(dir: &Path, field: &str, time: Option<f64>, arrows: Option<&str>) ->
 pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Section, String> {
     let figures = manuscript.join("figures");
     let tables = manuscript.join("tables");
+    // A figure that cannot be drawn does not keep the others (or the tables) from being
+    // drawn; every failure is reported, named by the problem file and the figure or table.
     let mut items = Vec::new();
+    let mut errors = Vec::new();
     for f in &p.figures {
-        items.extend(figure(p, f, output, &figures, &tables)?);
+        match figure(p, f, output, &figures, &tables) {
+            Ok(drawn) => items.extend(drawn),
+            Err(e) => errors.push(format!("{}: figures.{}: {e}", p.path.display(), f.id)),
+        }
     }
     for t in &p.tables {
-        items.push(metrics_table(p, t, output, &tables)?);
+        match metrics_table(p, t, output, &tables) {
+            Ok(table) => items.push(table),
+            Err(e) => errors.push(format!("{}: tables.{}: {e}", p.path.display(), t.id)),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(errors.join("\n"));
     }
     Ok(Section {
         title: p.title.clone(),

@@ -26,7 +26,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -54,6 +54,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
         "kinetic_energy_change",
         "min_density",
     ],
+    columns: &["t", "kinetic_energy", "u_max", "ipst_iterations", "shift_max"],
     outputs: 1,
 };
 
@@ -118,7 +119,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         .with_models(wall_density(p), wall_pressure(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
+    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: BLOWUP_MACH };
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `cavity`: {e}"))?;
     Ok(Box::new(Cavity {

@@ -29,7 +29,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -47,6 +47,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     build,
     check: |p| setup(p).map(drop),
     metrics: &["toe_rms", "particles_lost", "max_penetration"],
+    columns: &["t", "toe", "t_star", "toe_star", "max_speed", "ipst_iterations", "shift_max"],
     outputs: 0,
 };
 
@@ -139,7 +140,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     // 4 sqrt(g H) climbs to, and as far below, and a tank width on either side.
     let reach = th + 8.0 * hc;
     let domain = Domain::bounded([-tw, -reach], [2.0 * tw, reach]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref, blowup_factor: 10.0 };
+    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref, blowup_factor: BLOWUP_MACH };
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `dam_break`: {e}"))?;
     Ok(Box::new(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() }))

@@ -18,7 +18,7 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::scheme::{DensityModel, FluidScheme};
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -33,6 +33,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     build,
     check: |p| setup(p).map(drop),
     metrics: &["surface_particles", "interior_surface_particles", "outer_layer_missed"],
+    columns: &["t", "surface_particles", "interior_surface_particles"],
     outputs: 0,
 };
 
@@ -108,7 +109,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0: 10.0, u_ref: 1.0, blowup_factor: 10.0 };
+    let time = TimeSettings { cfl: p.float("cfl"), c0: 10.0, u_ref: 1.0, blowup_factor: BLOWUP_MACH };
     let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time)
         .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
     Ok(Box::new(Demo { sim, outer }))

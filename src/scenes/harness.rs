@@ -18,7 +18,8 @@ pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
 pub struct RunOptions {
     /// No progress bar and no plan on stderr.
     pub quiet: bool,
-    /// Overwrite a finished run in the output folder.
+    /// Overwrite a finished run in the output folder, or discard the checkpoint of an
+    /// interrupted run of other parameters.
     pub force: bool,
     /// Write `time tf steps` here about twice a second (for a parent runner's progress).
     pub progress_file: Option<PathBuf>,
@@ -66,6 +67,10 @@ fn io_err(path: &Path, e: std::io::Error) -> String {
     format!("{}: {e}", path.display())
 }
 
+/// Steps a run may need at its first time step: a billion steps of the smallest scene
+/// would take days; the paper preset's longest run takes 5e5.
+const MAX_STEPS: f64 = 1e9;
+
 /// Runs `entry` with `params`, writing into `out`. Returns the summary (completed or
 /// diverged), or an error.
 pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
@@ -81,14 +86,41 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             )));
         }
     }
+    // A checkpoint of other parameters is another case's interrupted work: keep it unless
+    // asked.
+    let ckpt_path = out.join("checkpoint.json");
+    let checkpoint = match read_checkpoint(&ckpt_path) {
+        Some(c) if c.params == *params => Some(c),
+        Some(_) if !opts.force => {
+            return Err(RunError::Input(format!(
+                "{} holds an interrupted run of other parameters; pass --force to discard it",
+                ckpt_path.display()
+            )))
+        }
+        _ => None,
+    };
     let mut scene = (entry.build)(params).map_err(RunError::Input)?;
+    let tf = params.float("tf");
+    // Parameters that shrink the time step without bound (re = 1e-30 is accepted as > 0)
+    // would step forever: refuse a run that needs more steps than any machine takes.
+    let (limit, dt) = scene.time_step_limit();
+    let steps_needed = tf / dt;
+    if steps_needed > MAX_STEPS {
+        return Err(RunError::Input(format!(
+            "tf = {tf} s needs {steps_needed:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {limit} limit), more than {MAX_STEPS:.0e}: check {}",
+            match limit {
+                "viscous" => "the viscosity (re)",
+                "body force" => "gravity",
+                _ => "the resolution and the speed of sound",
+            }
+        )));
+    }
     std::fs::create_dir_all(out).map_err(|e| RunError::Input(io_err(out, e)))?;
     // An old summary must not outlive the run that replaces it.
     let summary_path = out.join("summary.json");
     if summary_path.exists() {
         std::fs::remove_file(&summary_path).map_err(|e| RunError::Input(io_err(&summary_path, e)))?;
     }
-    let tf = params.float("tf");
     let output_dt = match params.float("output_dt") {
         x if x > 0.0 => x,
         _ => tf / 10.0,
@@ -106,7 +138,6 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let ts_path = out.join("timeseries.csv");
     let vtu_dir = out.join("vtu");
     std::fs::create_dir_all(&vtu_dir).map_err(|e| RunError::Input(io_err(&vtu_dir, e)))?;
-    let ckpt_path = out.join("checkpoint.json");
     let mut series: BTreeMap<String, Series> = BTreeMap::new();
     let mut stepping = 0.0f64;
     let mut snapshot_index = 0usize;
@@ -114,7 +145,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let mut next_sample = 0.0f64;
     let mut ts_rows = 0usize;
     // Resume from a checkpoint of this very case, if one is there.
-    match read_checkpoint(&ckpt_path, params) {
+    match checkpoint {
         Some(c) => {
             scene
                 .load_state(c.scene)
@@ -324,11 +355,10 @@ fn summary(
     }
 }
 
-/// The checkpoint in `path` if it was written for `params`.
-fn read_checkpoint(path: &Path, params: &Params) -> Option<Checkpoint> {
+/// The checkpoint in `path`, if there is a readable one.
+fn read_checkpoint(path: &Path) -> Option<Checkpoint> {
     let bytes = std::fs::read(path).ok()?;
-    let c: Checkpoint = serde_json::from_slice(&bytes).ok()?;
-    (c.params == *params).then_some(c)
+    serde_json::from_slice(&bytes).ok()
 }
 
 /// The column names of a CSV file's header, if it has one.

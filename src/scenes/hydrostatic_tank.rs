@@ -21,7 +21,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -38,6 +38,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     build,
     check: |p| setup(p).map(drop),
     metrics: &["pressure_rel_error", "max_speed", "particles_outside"],
+    columns: &["t", "max_speed", "pressure_rel_error", "ipst_iterations", "shift_max"],
     outputs: 0,
 };
 
@@ -93,7 +94,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
             .with_models(wall_density(p), wall_pressure(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: 10.0 };
+    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: BLOWUP_MACH };
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
     Ok(Box::new(Tank { sim, height, width }))

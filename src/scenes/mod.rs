@@ -27,6 +27,8 @@ pub trait SceneRun {
     fn time(&self) -> f64;
     /// Steps taken.
     fn steps(&self) -> u64;
+    /// The limit of CTVF eq. (61) that sets the next time step, and the step.
+    fn time_step_limit(&self) -> (&'static str, f64);
     /// The plan (bodies, scheme and terms), written at the top of the run log.
     fn plan(&self) -> String;
     /// Steps until the time reaches `t_stop` (steps are not shortened for it) without
@@ -70,6 +72,9 @@ pub struct SceneEntry {
     pub check: fn(&Params) -> Result<(), String>,
     /// Names of the metrics written to `summary.json`.
     pub metrics: &'static [&'static str],
+    /// The columns of `timeseries.csv`, in order (problem files' figures are checked
+    /// against them before anything runs).
+    pub columns: &'static [&'static str],
     /// Version of what the scene reports (metrics, time-series columns): raised when one is
     /// added, so that cached results without it are stale and rerun (it joins the cache
     /// key; 0 adds nothing to it).
@@ -99,10 +104,20 @@ impl SceneEntry {
     pub fn params_from_sets(&self, sets: &[String]) -> Result<Params, String> {
         let specs = (self.params)();
         let mut p = Params::defaults(&specs);
+        let mut given = std::collections::BTreeMap::new();
         for s in sets {
             let (k, v) = s
                 .split_once('=')
                 .ok_or_else(|| format!("scene `{}`: `--set {s}` is not of the form key=value", self.name))?;
+            // A key given twice is a typo in one of them: which value was meant is unknown.
+            if let Some(first) = given.insert(k.trim(), v) {
+                return Err(format!(
+                    "scene `{}`: `{}` is set twice (`{}={first}` and `{s}`)",
+                    self.name,
+                    k.trim(),
+                    k.trim()
+                ));
+            }
             p.set_str(self.name, &specs, k.trim(), v)?;
         }
         Ok(p)
@@ -153,6 +168,29 @@ mod tests {
         for e in SCENES {
             let p = Params::defaults(&(e.params)());
             assert!((e.check)(&p).is_ok(), "{}: defaults refused", e.name);
+        }
+    }
+
+    /// Every scene's time series has the columns it declares, in order, with and without
+    /// shifting.
+    #[test]
+    fn each_scene_samples_the_columns_it_declares() {
+        for e in SCENES {
+            let coarse = match e.name {
+                "taylor_green" | "taylor_green_3d" | "cavity" => vec!["nx=16"],
+                "dam_break" => vec!["dx=0.1"],
+                _ => vec![],
+            };
+            for pst in ["sun", "none"] {
+                let mut sets: Vec<String> = coarse.iter().map(|s| s.to_string()).collect();
+                if (e.params)().iter().any(|s| s.name == "pst") {
+                    sets.push(format!("pst={pst}"));
+                }
+                let p = e.params_from_sets(&sets).unwrap();
+                let mut run = (e.build)(&p).unwrap();
+                let keys: Vec<&str> = run.sample().iter().map(|(k, _)| *k).collect();
+                assert_eq!(keys, e.columns, "{} {sets:?}", e.name);
+            }
         }
     }
 }

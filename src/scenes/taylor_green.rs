@@ -31,7 +31,7 @@ use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -73,6 +73,18 @@ const fn entry<const D: usize>(name: &'static str, about: &'static str) -> Scene
         build: build::<D>,
         check: |p| setup::<D>(p).map(drop),
         metrics: METRICS,
+        columns: &[
+            "t",
+            "u_max",
+            "u_max_exact",
+            "l1_velocity",
+            "decay_rel_error",
+            "p_l1",
+            "kinetic_energy",
+            "kinetic_energy_exact",
+            "ipst_iterations",
+            "shift_max",
+        ],
         outputs: 1,
     }
 }
@@ -240,7 +252,7 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
         }
     }
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: 10.0 };
+    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: BLOWUP_MACH };
     Simulation::new(domain, kernel, fluid, None, scheme, time)
         .map_err(|e| format!("scene `{}`: {e}", name::<D>()))
 }

@@ -7,14 +7,22 @@ use rayon::prelude::*;
 /// acoustic `h / (c + |U|)`, viscous `h^2 / nu`, and body force `sqrt(h / |g|)` (the paper
 /// prints `h^2 / g`, which is not a time: SEED-NOTES, eq. 61).
 pub fn time_step(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) -> f64 {
-    let mut dt = h / (c + u_max);
+    binding_limit(cfl, h, c, u_max, nu, g).1
+}
+
+/// The limit of eq. (61) that sets the time step (`"acoustic"`, `"viscous"` or
+/// `"body force"`), and the time step, as [`time_step`].
+pub fn binding_limit(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) -> (&'static str, f64) {
+    let mut limit = ("acoustic", h / (c + u_max));
     if let Some(nu) = nu.filter(|&n| n > 0.0) {
-        dt = dt.min(h * h / nu);
+        if h * h / nu < limit.1 {
+            limit = ("viscous", h * h / nu);
+        }
     }
-    if g > 0.0 {
-        dt = dt.min((h / g).sqrt());
+    if g > 0.0 && (h / g).sqrt() < limit.1 {
+        limit = ("body force", (h / g).sqrt());
     }
-    cfl * dt
+    (limit.0, cfl * limit.1)
 }
 
 use crate::solver::LIGHT_LOOP_LEN;

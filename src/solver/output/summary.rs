@@ -40,8 +40,9 @@ pub struct Provenance {
 /// Bumped whenever the solver's results change for unchanged parameters; part of every
 /// cache key (with the crate version). 3: the neighbour lists test distances with the pair
 /// difference the passes compute, which changes the listing of pairs at exactly the
-/// support radius (W = 0 there, but the BQL mean pressure counts them).
-pub const SCHEME_VERSION: &str = "3";
+/// support radius (W = 0 there, but the BQL mean pressure counts them). 4: a run stops as
+/// diverged at Mach 1 ([`BLOWUP_MACH`](crate::solver::simulation::BLOWUP_MACH)), not 10.
+pub const SCHEME_VERSION: &str = "4";
 
 /// Versions of parts of the solver that only some cases use, each bumped whenever that
 /// part's results change for unchanged parameters: `(parameter, value, version)`. A case
