@@ -7,7 +7,7 @@ use sphrepro::solver::math::Vector;
 use sphrepro::solver::nnps::Domain;
 use sphrepro::solver::particles::{Fluid, FluidInit};
 use sphrepro::solver::scheme::{FluidSettings, Pst, SchemeName};
-use sphrepro::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
+use sphrepro::solver::simulation::{Simulation, TimeSettings};
 
 #[test]
 fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
@@ -37,7 +37,7 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
             FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
         let s = scheme.fluid_scheme(&settings);
         let fluid = Fluid::new("fluid", dx, init.clone(), s.transport.is_some()).unwrap();
-        let time = TimeSettings { cfl: 0.25, c0: 10.0, u_ref: 1.0, blowup_factor: BLOWUP_MACH };
+        let time = TimeSettings::new(0.25, 10.0, 1.0);
         let mut sim =
             Simulation::new(Domain::periodic([0.0; 3], [1.0; 3]), kernel, fluid, None, s, time).unwrap();
         for _ in 0..20 {

@@ -2,6 +2,7 @@
 //! scheme built from them, and the ParaView snapshots of fluid and wall bodies.
 
 use super::params::{Bound, Params, Spec};
+use crate::solver::integrator::RatePositions;
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
@@ -10,7 +11,7 @@ use crate::solver::scheme::{
     paper, Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
     SurfacePressure,
 };
-use crate::solver::simulation::Simulation;
+use crate::solver::simulation::{Simulation, TimeSettings};
 use std::path::Path;
 
 const SWITCH: &[&str] = &["auto", "on", "off"];
@@ -72,6 +73,15 @@ pub fn free_surface_params() -> Vec<Spec> {
         "evolve",
         "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), held at 0 where isolated, or evolved but not below 0",
     )]
+}
+
+/// The time loop's settings from the common parameters (`cfl`, `rate_positions`), with the
+/// scene's speed of sound and reference speed.
+pub fn time_settings(p: &Params, c0: f64, u_ref: f64) -> TimeSettings {
+    TimeSettings {
+        rate_positions: RatePositions::from_name(p.str("rate_positions")).expect("checked choice"),
+        ..TimeSettings::new(p.float("cfl"), c0, u_ref)
+    }
 }
 
 fn switch(p: &Params, key: &str, all: bool) -> bool {

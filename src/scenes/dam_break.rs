@@ -18,8 +18,8 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies, wall_density,
-    wall_from, wall_params, wall_pressure, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
+    time_settings, wall_density, wall_from, wall_params, wall_pressure, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
 use super::geometry::{box_walls, lattice};
@@ -29,7 +29,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
+use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -140,7 +140,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     // 4 sqrt(g H) climbs to, and as far below, and a tank width on either side.
     let reach = th + 8.0 * hc;
     let domain = Domain::bounded([-tw, -reach], [2.0 * tw, reach]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref, blowup_factor: BLOWUP_MACH };
+    let time = time_settings(p, c0, u_ref);
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `dam_break`: {e}"))?;
     Ok(Box::new(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() }))

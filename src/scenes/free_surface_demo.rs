@@ -8,7 +8,7 @@
 
 use super::common::{
     check_size, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim,
-    scheme_params, snapshot_bodies, wall_from, FluidConstants,
+    scheme_params, snapshot_bodies, time_settings, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -18,7 +18,7 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::scheme::{DensityModel, FluidScheme};
-use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
+use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -109,7 +109,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0: 10.0, u_ref: 1.0, blowup_factor: BLOWUP_MACH };
+    let time = time_settings(p, 10.0, 1.0);
     let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time)
         .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
     Ok(Box::new(Demo { sim, outer }))

@@ -11,8 +11,8 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies, wall_density,
-    wall_from, wall_params, wall_pressure, FluidConstants,
+    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
+    time_settings, wall_density, wall_from, wall_params, wall_pressure, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -21,7 +21,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
+use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -94,7 +94,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
             .with_models(wall_density(p), wall_pressure(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
-    let time = TimeSettings { cfl: p.float("cfl"), c0, u_ref: constants.u_ref, blowup_factor: BLOWUP_MACH };
+    let time = time_settings(p, c0, constants.u_ref);
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
     Ok(Box::new(Tank { sim, height, width }))

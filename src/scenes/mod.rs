@@ -137,6 +137,12 @@ pub fn common_params(tf: f64) -> Vec<Spec> {
         ),
         Spec::float("sample_dt", 0.0, Bound::NonNegative, "interval between time-series rows (s); 0: tf/100"),
         Spec::float("cfl", 0.25, Bound::Positive, "factor of the time-step limits, CTVF eq. (61)"),
+        Spec::choice(
+            "rate_positions",
+            crate::solver::integrator::RatePositions::NAMES,
+            "end",
+            "where the density and pressure rates (eqs. 56-57) are evaluated: end (after the drift, at the new positions) or start (sec. 3.7: before it, at the step's start positions)",
+        ),
     ]
 }
 

@@ -21,7 +21,7 @@
 
 use super::common::{
     check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, shifting_columns,
-    snapshot_bodies, FluidConstants,
+    snapshot_bodies, time_settings, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -31,7 +31,7 @@ use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
 use crate::solver::particles::{Fluid, FluidInit};
 use crate::solver::scheme::FluidScheme;
-use crate::solver::simulation::{Simulation, TimeSettings, BLOWUP_MACH};
+use crate::solver::simulation::Simulation;
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -252,7 +252,7 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
         }
     }
     let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let time = TimeSettings { cfl: p.float("cfl"), c0: C0, u_ref: U, blowup_factor: BLOWUP_MACH };
+    let time = time_settings(p, C0, U);
     Simulation::new(domain, kernel, fluid, None, scheme, time)
         .map_err(|e| format!("scene `{}`: {e}", name::<D>()))
 }

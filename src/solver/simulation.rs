@@ -1,6 +1,6 @@
 //! A simulation: a domain, the bodies, a scheme and the kick-drift-kick loop.
 
-use crate::solver::integrator;
+use crate::solver::integrator::{self, RatePositions};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
@@ -36,6 +36,18 @@ pub struct TimeSettings {
     /// A speed above `blowup_factor * c0` counts as a blow-up, so that a run that grows
     /// without turning NaN still stops ([`BLOWUP_MACH`] in every scene).
     pub blowup_factor: f64,
+    /// Where the density and pressure rates are evaluated (a checkpoint written before the
+    /// choice existed ran `End`, the default).
+    #[serde(default)]
+    pub rate_positions: RatePositions,
+}
+
+impl TimeSettings {
+    /// The settings of a scene: eq. (61)'s factor, the speed of sound, the reference speed;
+    /// blow-ups at [`BLOWUP_MACH`]; the rates at the default [`RatePositions`].
+    pub fn new(cfl: f64, c0: f64, u_ref: f64) -> Self {
+        Self { cfl, c0, u_ref, blowup_factor: BLOWUP_MACH, rate_positions: RatePositions::default() }
+    }
 }
 
 /// The Mach number at which a run counts as blown up. Weakly compressible SPH takes c0 at
@@ -320,35 +332,57 @@ impl<const D: usize> Simulation<D> {
         lap(clock, &mut self.times.ipst);
     }
 
-    /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60).
+    /// Pass A: the density and pressure rates (eqs. 25-26) on the current neighbour lists
+    /// and walls, and their updates over `dt` (eqs. 56-57).
+    fn update_density_and_pressure(&mut self, dt: f64) {
+        let (st, walls) = (&mut self.state, self.walls.as_ref());
+        self.passes.update_density_and_pressure(
+            &mut st.fluid,
+            &self.neighbours,
+            walls,
+            &st.scheme,
+            &mut st.rates,
+            dt,
+        );
+    }
+
+    /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60): the half kick and the
+    /// transport velocity (eqs. 54-55); the drift (eq. 59); the accelerations at the new
+    /// positions and the closing half kick (eq. 60). The density and pressure rates
+    /// (eqs. 25-26) and their updates (eqs. 56-57) come after the drift, or before it, at
+    /// the start positions, as sec. 3.7 orders them ([`RatePositions`]).
     pub fn step(&mut self, max_dt: f64) -> Result<(), Divergence> {
         let clock = std::time::Instant::now();
         let dt_nominal = self.nominal_dt();
         let dt = dt_nominal.min(max_dt);
+        let rates_at = self.time_settings.rate_positions;
         {
             let st = &mut self.state;
-            let Fluid { x, u, u_hat, .. } = &mut st.fluid;
-            integrator::kick_drift(x, u, u_hat.as_deref_mut(), &st.rates.du, &st.rates.a_c, dt);
+            let Fluid { u, u_hat, .. } = &mut st.fluid;
+            integrator::kick_transport(u, u_hat.as_deref_mut(), &st.rates.du, &st.rates.a_c, dt);
+        }
+        let mut clock = lap(clock, &mut self.times.integrate);
+        if rates_at == RatePositions::Start {
+            // The neighbour lists and the walls are still those of the start positions.
+            self.update_density_and_pressure(dt);
+            clock = lap(clock, &mut self.times.pressure);
+        }
+        {
+            let Fluid { x, u, u_hat, .. } = &mut self.state.fluid;
+            integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
         self.rebuild();
         let mut clock = lap(clock, &mut self.times.neighbours);
-        {
-            let (st, walls) = (&mut self.state, self.walls.as_ref());
-            if st.scheme.density == DensityModel::Summation {
-                FluidPasses::summation_density(&mut st.fluid, &self.fluid_density, walls);
-                clock = lap(clock, &mut self.times.density);
-            }
-            self.passes.update_density_and_pressure(
-                &mut st.fluid,
-                &self.neighbours,
-                walls,
-                &st.scheme,
-                &mut st.rates,
-                dt,
-            );
+        if self.state.scheme.density == DensityModel::Summation {
+            let walls = self.walls.as_ref();
+            FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
+            clock = lap(clock, &mut self.times.density);
         }
-        // The walls follow the updated fluid pressure before the accelerations use it.
+        if rates_at == RatePositions::End {
+            self.update_density_and_pressure(dt);
+        }
+        // The walls follow the fluid's new pressure before the accelerations use it.
         self.extrapolate_walls();
         lap(clock, &mut self.times.pressure);
         // For the next step (its kick applies the homogenisation acceleration).
@@ -460,5 +494,73 @@ impl<const D: usize> Simulation<D> {
     /// Positions wrapped into the box, for output.
     pub fn positions(&self) -> &[Vector<D>] {
         &self.state.fluid.x
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::kernel::KernelKind;
+    use crate::solver::particles::FluidInit;
+    use crate::solver::scheme::{FluidSettings, Pst, SchemeName};
+
+    /// A Taylor-Green-like vortex on a perturbed 16x16 lattice in a periodic unit box,
+    /// CTVF with IPST, with the rates taken at `rates_at`.
+    fn vortex(rates_at: RatePositions) -> Simulation<2> {
+        let n = 16;
+        let dx = 1.0 / n as f64;
+        let mut init = FluidInit::<2>::default();
+        for j in 0..n {
+            for i in 0..n {
+                let wobble = 0.1 * dx * ((7 * i + 3 * j) as f64).sin();
+                let x = Vector::<2>::new((i as f64 + 0.5) * dx + wobble, (j as f64 + 0.5) * dx - wobble);
+                let (a, b) = (2.0 * std::f64::consts::PI * x[0], 2.0 * std::f64::consts::PI * x[1]);
+                init.x.push(x);
+                init.u.push(Vector::<2>::new(-a.cos() * b.sin(), a.sin() * b.cos()));
+                init.m.push(dx * dx);
+                init.rho.push(1.0);
+                init.p.push(0.0);
+            }
+        }
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let settings = FluidSettings {
+            pst: Pst::Ipst,
+            ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01)
+        };
+        let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+        let fluid = Fluid::new("fluid", dx, init, true).unwrap();
+        let time = TimeSettings { rate_positions: rates_at, ..TimeSettings::new(0.25, 10.0, 1.0) };
+        Simulation::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel, fluid, None, scheme, time).unwrap()
+    }
+
+    /// Sec. 3.7: the pressure and density of step n+1 come from the rates at the start
+    /// positions x^n with the half-step velocities; `RatePositions::End` takes them after the
+    /// drift, so its pressure differs.
+    #[test]
+    fn the_rates_are_taken_where_rate_positions_says() {
+        for (rates_at, at_start) in [(RatePositions::Start, true), (RatePositions::End, false)] {
+            let mut sim = vortex(rates_at);
+            for _ in 0..20 {
+                sim.step(f64::INFINITY).unwrap();
+            }
+            // By hand: the half kick and u~ (eqs. 54-55), then pass A on the start lists.
+            let dt = sim.nominal_dt();
+            let mut probe = sim.state.clone();
+            let Fluid { u, u_hat, .. } = &mut probe.fluid;
+            integrator::kick_transport(u, u_hat.as_deref_mut(), &probe.rates.du, &probe.rates.a_c, dt);
+            let walls = sim.walls.as_ref();
+            sim.passes.update_density_and_pressure(
+                &mut probe.fluid,
+                &sim.neighbours,
+                walls,
+                &probe.scheme,
+                &mut probe.rates,
+                dt,
+            );
+            sim.step(f64::INFINITY).unwrap();
+            let bits = |f: &Fluid<2>| f.by_id(&f.p).iter().map(|p| p.to_bits()).collect::<Vec<_>>();
+            let same = bits(&probe.fluid) == bits(&sim.state.fluid);
+            assert_eq!(same, at_start, "{rates_at:?}");
+        }
     }
 }
