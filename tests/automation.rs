@@ -294,6 +294,20 @@ fn a_match_that_selects_nothing_and_zero_counts_are_refused() {
     }
 }
 
+/// A problems folder named on the command line that does not exist is a typo: `list`
+/// refuses it (without --problems, outside a checkout, it still lists the scenes).
+#[test]
+fn list_refuses_a_problems_folder_that_does_not_exist() {
+    let env = Env::new(VALID);
+    let o = Command::new(BIN).current_dir(&env.root).args(["list", "--problems", "nope"]).output().unwrap();
+    assert_eq!(o.status.code(), Some(2), "{}", text(&o));
+    assert!(text(&o).contains("nope"), "{}", text(&o));
+    let bare = env.root.join("bare");
+    std::fs::create_dir_all(&bare).unwrap();
+    let o = Command::new(BIN).current_dir(&bare).arg("list").output().unwrap();
+    assert!(o.status.success() && text(&o).contains("taylor_green"), "{}", text(&o));
+}
+
 #[test]
 fn an_unwritable_output_folder_is_reported_with_its_path() {
     let env = Env::new(VALID);

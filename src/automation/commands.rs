@@ -62,7 +62,9 @@ pub fn list(dirs: &Dirs, preset: &str) -> u8 {
             }
             OK
         }
-        Err(e) if !dirs.problems.exists() => {
+        // Outside a checkout (no `problems/` here) `list` still shows the scenes; a folder
+        // named with --problems that does not exist is a typo.
+        Err(e) if !dirs.problems.exists() && dirs.problems == Path::new("problems") => {
             println!("(no problems: {e})");
             OK
         }
