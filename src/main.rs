@@ -40,7 +40,7 @@ struct Cli {
 #[derive(Args, Clone)]
 struct DirArgs {
     /// Folder of problem files (*.toml).
-    #[arg(long, default_value = "problems")]
+    #[arg(long, default_value = commands::DEFAULT_PROBLEMS)]
     problems: PathBuf,
     /// Folder of results (one sub-folder per problem and case).
     #[arg(long, default_value = "output")]

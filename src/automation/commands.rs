@@ -6,6 +6,9 @@ use super::runner::{self, Options};
 use super::{cache, check};
 use std::path::{Path, PathBuf};
 
+/// The problems folder when none is named: `problems/` of the checkout.
+pub const DEFAULT_PROBLEMS: &str = "problems";
+
 /// Folders every automation command reads or writes.
 #[derive(Clone, Debug)]
 pub struct Dirs {
@@ -64,7 +67,7 @@ pub fn list(dirs: &Dirs, preset: &str) -> u8 {
         }
         // Outside a checkout (no `problems/` here) `list` still shows the scenes; a folder
         // named with --problems that does not exist is a typo.
-        Err(e) if !dirs.problems.exists() && dirs.problems == Path::new("problems") => {
+        Err(e) if !dirs.problems.exists() && dirs.problems == Path::new(DEFAULT_PROBLEMS) => {
             println!("(no problems: {e})");
             OK
         }

@@ -349,7 +349,7 @@ macro_rules! forward_to_sim {
         fn steps(&self) -> u64 {
             self.sim.steps()
         }
-        fn time_step_limit(&self) -> (&'static str, f64) {
+        fn time_step_limit(&self) -> ($crate::solver::integrator::TimeStepLimit, f64) {
             self.sim.time_step_limit()
         }
         fn advance(

@@ -2,6 +2,7 @@
 
 use super::{params::Params, SceneEntry, SceneRun};
 
+use crate::solver::integrator::TimeStepLimit;
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
 use std::collections::BTreeMap;
@@ -107,11 +108,12 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let steps_needed = tf / dt;
     if steps_needed > MAX_STEPS {
         return Err(RunError::Input(format!(
-            "tf = {tf} s needs {steps_needed:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {limit} limit), more than {MAX_STEPS:.0e}: check {}",
+            "tf = {tf} s needs {steps_needed:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit), more than {MAX_STEPS:.0e}: check {}",
+            limit.name(),
             match limit {
-                "viscous" => "the viscosity (re)",
-                "body force" => "gravity",
-                _ => "the resolution and the speed of sound",
+                TimeStepLimit::Viscous => "the viscosity (re)",
+                TimeStepLimit::BodyForce => "gravity",
+                TimeStepLimit::Acoustic => "the resolution and the speed of sound",
             }
         )));
     }

@@ -28,7 +28,7 @@ pub trait SceneRun {
     /// Steps taken.
     fn steps(&self) -> u64;
     /// The limit of CTVF eq. (61) that sets the next time step, and the step.
-    fn time_step_limit(&self) -> (&'static str, f64);
+    fn time_step_limit(&self) -> (crate::solver::integrator::TimeStepLimit, f64);
     /// The plan (bodies, scheme and terms), written at the top of the run log.
     fn plan(&self) -> String;
     /// Steps until the time reaches `t_stop` (steps are not shortened for it) without
@@ -109,16 +109,12 @@ impl SceneEntry {
             let (k, v) = s
                 .split_once('=')
                 .ok_or_else(|| format!("scene `{}`: `--set {s}` is not of the form key=value", self.name))?;
+            let k = k.trim();
             // A key given twice is a typo in one of them: which value was meant is unknown.
-            if let Some(first) = given.insert(k.trim(), v) {
-                return Err(format!(
-                    "scene `{}`: `{}` is set twice (`{}={first}` and `{s}`)",
-                    self.name,
-                    k.trim(),
-                    k.trim()
-                ));
+            if let Some(first) = given.insert(k, v) {
+                return Err(format!("scene `{}`: `{k}` is set twice (`{k}={first}` and `{s}`)", self.name));
             }
-            p.set_str(self.name, &specs, k.trim(), v)?;
+            p.set_str(self.name, &specs, k, v)?;
         }
         Ok(p)
     }

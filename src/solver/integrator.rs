@@ -35,17 +35,42 @@ pub fn time_step(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) 
     binding_limit(cfl, h, c, u_max, nu, g).1
 }
 
-/// The limit of eq. (61) that sets the time step (`"acoustic"`, `"viscous"` or
-/// `"body force"`), and the time step, as [`time_step`].
-pub fn binding_limit(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) -> (&'static str, f64) {
-    let mut limit = ("acoustic", h / (c + u_max));
-    if let Some(nu) = nu.filter(|&n| n > 0.0) {
-        if h * h / nu < limit.1 {
-            limit = ("viscous", h * h / nu);
+/// The three limits of eq. (61).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TimeStepLimit {
+    /// `h / (c + |U|)`.
+    Acoustic,
+    /// `h^2 / nu`.
+    Viscous,
+    /// `sqrt(h / |g|)`.
+    BodyForce,
+}
+
+impl TimeStepLimit {
+    /// The limit's name, for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Acoustic => "acoustic",
+            Self::Viscous => "viscous",
+            Self::BodyForce => "body force",
         }
     }
-    if g > 0.0 && (h / g).sqrt() < limit.1 {
-        limit = ("body force", (h / g).sqrt());
+}
+
+/// The limit of eq. (61) that sets the time step, and the time step, as [`time_step`].
+pub fn binding_limit(cfl: f64, h: f64, c: f64, u_max: f64, nu: Option<f64>, g: f64) -> (TimeStepLimit, f64) {
+    let mut limit = (TimeStepLimit::Acoustic, h / (c + u_max));
+    if let Some(nu) = nu.filter(|&n| n > 0.0) {
+        let viscous = h * h / nu;
+        if viscous < limit.1 {
+            limit = (TimeStepLimit::Viscous, viscous);
+        }
+    }
+    if g > 0.0 {
+        let body = (h / g).sqrt();
+        if body < limit.1 {
+            limit = (TimeStepLimit::BodyForce, body);
+        }
     }
     (limit.0, cfl * limit.1)
 }
