@@ -137,6 +137,33 @@ fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
     assert!(t.contains("tiny/a") && t.contains("l1_velocity_final") && t.contains("> max 1e-9"), "{t}");
 }
 
+/// A diverged case is done (a result, not rerun) but breaches every bound on it, even one
+/// its metrics would meet: they are those of the moment it blew up.
+#[test]
+fn a_diverged_case_is_done_but_breaches_its_bounds() {
+    let env = Env::new(
+        r#"title = "blows up"
+scene = "taylor_green"
+[presets.quick]
+[[cases]]
+name = "a"
+params = { nx = 8, scheme = "edac", cfl = 5.0, tf = 1.0 }
+[[bounds]]
+metric = "l1_velocity_final"
+max = 1e300
+"#,
+    );
+    let o = env.run(&["run", "tiny"]);
+    assert!(text(&o).contains("diverged"), "{}", text(&o));
+    assert_eq!(env.summary("a")["status"], "diverged");
+    let o = env.run(&["run", "tiny"]);
+    assert!(text(&o).contains("0 case(s) to run, 1 done"), "{}", text(&o));
+    let o = env.run(&["check"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("tiny/a") && t.contains("the run diverged at t = ") && t.contains("tiny.toml:"), "{t}");
+}
+
 #[test]
 fn a_killed_run_is_not_done_and_is_repeated() {
     use std::os::unix::process::CommandExt;

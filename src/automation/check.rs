@@ -3,6 +3,7 @@
 
 use super::cache::{self, State};
 use super::registry::Problem;
+use crate::solver::output::summary::Status;
 use std::path::Path;
 
 /// One bound checked against one case.
@@ -16,7 +17,9 @@ pub struct Breach {
 
 /// Checks every bound of `problems` against the results under `output`. Returns the
 /// number of (bound, case) pairs that hold and every breach; a missing or unfinished
-/// result is a breach.
+/// result is a breach, and so is a diverged one: its metrics are those of the moment it
+/// blew up, so a bound on them would hold by accident (a lost-particle count of 0 at the
+/// step the fields turned NaN).
 pub fn check(output: &Path, problems: &[Problem]) -> (usize, Vec<Breach>) {
     let mut ok = 0;
     let mut bad = Vec::new();
@@ -40,6 +43,19 @@ pub fn check(output: &Path, problems: &[Problem]) -> (usize, Vec<Breach>) {
                         continue;
                     }
                 };
+                if s.status == Status::Diverged {
+                    bad.push(Breach {
+                        case,
+                        what: format!(
+                            "{}: the run diverged at t = {:.6e}, step {}: {} (bound on line {at})",
+                            b.metric,
+                            s.final_time,
+                            s.step.map_or_else(|| "?".into(), |n| n.to_string()),
+                            s.reason.unwrap_or_default()
+                        ),
+                    });
+                    continue;
+                }
                 let Some(v) = s.metrics.get(&b.metric).copied() else {
                     bad.push(Breach {
                         case,
