@@ -240,6 +240,16 @@ fn main() -> ExitCode {
             std::process::exit(130);
         }
     });
+    // SIGUSR1 is what a case's runner, dying, sends its simulation (runner.rs): stop as on
+    // a first Ctrl-C, however often it comes.
+    #[cfg(unix)]
+    // SAFETY: the handler only stores to an atomic, which is async-signal-safe.
+    unsafe {
+        extern "C" fn on_runner_death(_: libc::c_int) {
+            harness::INTERRUPTED.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
+        libc::signal(libc::SIGUSR1, on_runner_death as extern "C" fn(libc::c_int) as libc::sighandler_t);
+    }
     // Run the command on a worker of the pool: the solver's parallel loops are then forked
     // from inside it, without handing each one over from a thread outside the pool, which
     // costs a sleep and a wake-up per loop (measured: 15 % more particle-steps per second on

@@ -161,7 +161,10 @@ max = 1e300
     let o = env.run(&["check"]);
     let t = text(&o);
     assert_eq!(o.status.code(), Some(1), "{t}");
-    assert!(t.contains("tiny/a") && t.contains("the run diverged at t = ") && t.contains("tiny.toml:"), "{t}");
+    assert!(
+        t.contains("tiny/a") && t.contains("the run diverged at t = ") && t.contains("tiny.toml:"),
+        "{t}"
+    );
 }
 
 #[test]
@@ -203,6 +206,55 @@ params = { nx = 16, tf = 20.0 }
     let t = text(&o);
     assert!(o.status.success(), "{t}");
     assert!(t.contains("run     tiny/a"), "{t}");
+    assert_eq!(env.summary("a")["status"], "completed");
+}
+
+/// A runner killed outright (SIGKILL, its simulation spared) does not leave the
+/// simulation running on its own: it stops with a checkpoint (Linux: it gets SIGTERM), and
+/// the next run resumes it.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_killed_runner_takes_its_simulation_with_it() {
+    let env = Env::new(
+        r#"title = "one slow case"
+scene = "taylor_green"
+[presets.quick]
+[[cases]]
+name = "a"
+params = { nx = 16, tf = 20.0 }
+"#,
+    );
+    let mut runner = env.cmd(&["run", "tiny", "--jobs", "1"]).spawn().unwrap();
+    let t0 = std::time::Instant::now();
+    let progress = loop {
+        let p = std::fs::read_dir(env.root.join("output/tiny")).ok().and_then(|mut d| {
+            d.find_map(|e| e.ok().map(|e| e.path().join("progress")).filter(|p| p.exists()))
+        });
+        if let Some(p) = p {
+            break p;
+        }
+        assert!(t0.elapsed().as_secs() < 60, "no progress file");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    };
+    runner.kill().unwrap();
+    let _ = runner.wait();
+    let dir = progress.parent().unwrap();
+    let t0 = std::time::Instant::now();
+    while !dir.join("summary.json").exists() {
+        assert!(
+            t0.elapsed().as_secs() < 30,
+            "the orphaned simulation did not stop; its log:\n{}",
+            std::fs::read_to_string(dir.join("run.log")).unwrap_or_default()
+        );
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    // Let it finish writing, then check it stopped short of tf, checkpointed.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(env.summary("a")["status"], "failed");
+    assert!(dir.join("checkpoint.json").exists());
+    let o = env.run(&["run", "tiny"]);
+    let t = text(&o);
+    assert!(o.status.success() && t.contains("resuming"), "{t}");
     assert_eq!(env.summary("a")["status"], "completed");
 }
 

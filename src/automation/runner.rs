@@ -79,7 +79,7 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
                     continue;
                 }
                 State::Failed(r) => match Lock::holder(&e.dir) {
-                    Some(pid) => format!("running in another runner (pid {pid}): wait for it"),
+                    Some(pid) => format!("running under runner pid {pid}: wait for it"),
                     None => format!("failed before ({r}): re-run, resuming if it can"),
                 },
                 State::Missing(Some(change)) => format!("stale: {change}"),
@@ -196,12 +196,15 @@ fn run_one(
     let name = format!("{}/{}", task.problem, e.case.name);
     // One runner per case: wait while another holds it.
     let mut waited = false;
-    let _lock = loop {
+    let lock = loop {
         match Lock::try_take(&e.dir) {
             Ok(Try::Taken(l)) => break l,
             Ok(Try::Held(pid)) => {
                 if !waited {
-                    say(mp, format!("wait    {name} (another runner, pid {pid}, holds it)"));
+                    say(
+                        mp,
+                        format!("wait    {name} (held by runner pid {pid} or the simulation it started)"),
+                    );
                     waited = true;
                 }
                 if INTERRUPTED.load(Ordering::SeqCst) {
@@ -251,6 +254,8 @@ fn run_one(
         Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
     };
     cmd.stdout(Stdio::from(log)).stderr(Stdio::from(log2));
+    #[cfg(unix)]
+    bind_to_runner(&mut cmd, lock.inherit_fd());
     let t0 = Instant::now();
     let mut child = match cmd.spawn() {
         Ok(c) => c,
@@ -301,6 +306,40 @@ fn run_one(
         }
         State::Failed(r) => Outcome::Failed(format!("{r} ({code})")),
         State::Missing(_) => Outcome::Failed(format!("no result ({code})")),
+    }
+}
+
+/// Ties the simulation's life to this runner's: it inherits the case's lock, so no other
+/// runner starts the case while it lives, and (Linux) it is sent SIGUSR1, which stops it
+/// with a checkpoint as Ctrl-C does, when the runner dies, even by SIGKILL. Not SIGTERM:
+/// the kernel sends the signal again each time the child passes to another of the dying
+/// runner's threads, and a second SIGTERM, like a second Ctrl-C, ends a run at once.
+#[cfg(unix)]
+fn bind_to_runner(cmd: &mut Command, lock_fd: std::os::unix::io::RawFd) {
+    use std::os::unix::process::CommandExt;
+    #[cfg(target_os = "linux")]
+    // SAFETY: getpid is async-signal-safe and called before the fork.
+    let runner = unsafe { libc::getpid() };
+    // SAFETY: between fork and exec only async-signal-safe calls (fcntl, prctl, getppid)
+    // on a descriptor this process owns.
+    unsafe {
+        cmd.pre_exec(move || {
+            let flags = libc::fcntl(lock_fd, libc::F_GETFD);
+            if flags < 0 || libc::fcntl(lock_fd, libc::F_SETFD, flags & !libc::FD_CLOEXEC) < 0 {
+                return Err(std::io::Error::last_os_error());
+            }
+            #[cfg(target_os = "linux")]
+            {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGUSR1) < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                // The runner may have died before the prctl.
+                if libc::getppid() != runner {
+                    return Err(std::io::Error::other("the runner has exited"));
+                }
+            }
+            Ok(())
+        });
     }
 }
 
