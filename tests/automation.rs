@@ -258,6 +258,27 @@ params = { nx = 16, tf = 20.0 }
     assert_eq!(env.summary("a")["status"], "completed");
 }
 
+/// `--plot-only` never draws over the figures of a problem with nothing (a mistyped
+/// --output, a fresh checkout): it names the problem, writes nothing and exits 1.
+#[test]
+fn plot_only_without_results_overwrites_nothing() {
+    let env = Env::new(&three_cases(0.02).replace("BOUND", "1.0"));
+    let o = env.run(&["reproduce", "--plot-only"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("tiny: no case has a result under output"), "{t}");
+    assert!(!env.root.join("manuscript/manuscript.md").exists());
+    assert!(env.run(&["run", "tiny"]).status.success());
+    let o = env.run(&["reproduce", "--plot-only"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let md = env.root.join("manuscript/manuscript.md");
+    let before = std::fs::read_to_string(&md).unwrap();
+    std::fs::rename(env.root.join("output"), env.root.join("elsewhere")).unwrap();
+    let o = env.run(&["reproduce", "--plot-only"]);
+    assert_eq!(o.status.code(), Some(1), "{}", text(&o));
+    assert_eq!(std::fs::read_to_string(&md).unwrap(), before);
+}
+
 #[test]
 fn two_runs_at_once_simulate_each_case_once() {
     let env = Env::new(&three_cases(0.3).replace("BOUND", "1.0"));

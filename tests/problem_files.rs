@@ -205,8 +205,9 @@ fn cavity_presets_and_reference_points() {
     assert_eq!(quick.bounds.len(), 3, "{:?}", quick.bounds);
 }
 
-/// Every figure and table of every problem is drawn with no results at all (as after a
-/// fresh checkout with `--plot-only`): empty curves, the published points, "no result".
+/// Every figure and table of every problem can be drawn with no results at all: empty
+/// curves, the published points, "no result". (The command line does not draw a problem
+/// none of whose cases has a result, so as not to overwrite its last figures.)
 #[test]
 fn every_problem_plots_without_results() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems");

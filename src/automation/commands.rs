@@ -178,6 +178,17 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
     let mut sections = Vec::new();
     let mut errors = Vec::new();
     for p in problems {
+        // Figures of nothing would overwrite the last ones drawn from results (a mistyped
+        // --output, every case failed): leave them, and say so.
+        let entries = super::cache::entries(&dirs.output, p);
+        if !entries.is_empty() && !entries.iter().any(|e| e.is_done()) {
+            errors.push(format!(
+                "{}: no case has a result under {}; its figures and tables are left as they were",
+                p.name,
+                dirs.output.display()
+            ));
+            continue;
+        }
         match super::study::regenerate(p, &dirs.output, &dirs.manuscript) {
             Ok(section) => sections.push(section),
             Err(e) => {
