@@ -258,6 +258,22 @@ params = { nx = 16, tf = 20.0 }
     assert_eq!(env.summary("a")["status"], "completed");
 }
 
+/// A case whose time step would need more steps than any machine takes is refused when the
+/// problem file is loaded, before anything runs, naming file, case and the binding limit.
+#[test]
+fn a_case_that_would_step_forever_is_refused_before_anything_runs() {
+    let env =
+        Env::new(&three_cases(0.02).replace("BOUND", "1.0").replace("nx = 14 }", "nx = 14, re = 1e-30 }"));
+    let o = env.run(&["run", "tiny"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{t}");
+    assert!(
+        t.contains("tiny.toml") && t.contains("viscous limit") && t.contains("check the viscosity (re)"),
+        "{t}"
+    );
+    assert!(!env.root.join("output").exists(), "{t}");
+}
+
 /// `--plot-only` never draws over the figures of a problem with nothing (a mistyped
 /// --output, a fresh checkout): it names the problem, writes nothing and exits 1.
 #[test]

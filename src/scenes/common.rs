@@ -2,7 +2,7 @@
 //! scheme built from them, and the ParaView snapshots of fluid and wall bodies.
 
 use super::params::{Bound, Params, Spec};
-use crate::solver::integrator::RatePositions;
+use crate::solver::integrator::{binding_limit, RatePositions, TimeStepLimit};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
@@ -162,9 +162,36 @@ pub fn require_free_surface_scheme(scene: &str, p: &Params) -> Result<(), String
     ))
 }
 
+/// Steps a run may need at its first time step: a billion steps of the smallest scene
+/// would take days; the paper preset's longest run takes 5e5.
+const MAX_STEPS: f64 = 1e9;
+
+/// Parameters that shrink the time step of eq. (61) without bound (`re` = 1e-30 is > 0)
+/// would step forever: refuse, before anything runs, a run needing more steps than any
+/// machine takes, naming the limit that binds.
+fn check_step_count(scene: &str, p: &Params, h: f64, c: &FluidConstants) -> Result<(), String> {
+    let g = c.gravity.iter().map(|v| v * v).sum::<f64>().sqrt();
+    let (limit, dt) = binding_limit(p.float("cfl"), h, c.c0, c.u_ref, c.nu, g);
+    let tf = p.float("tf");
+    let steps = tf / dt;
+    if steps > MAX_STEPS {
+        return Err(format!(
+            "scene `{scene}`: `tf` = {tf} s needs {steps:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit), more than {MAX_STEPS:.0e}: check {}",
+            limit.name(),
+            match limit {
+                TimeStepLimit::Viscous => "the viscosity (re)",
+                TimeStepLimit::BodyForce => "gravity",
+                TimeStepLimit::Acoustic => "the resolution and the speed of sound",
+            }
+        ));
+    }
+    Ok(())
+}
+
 /// The kernel (normalised in `D` dimensions), smoothing length and scheme the parameters
 /// ask for. A support that does not reach the nearest particle (`support * hdx <= 1`) is
 /// refused: the particles would have no neighbours, and Sun's shifting divides by W(dx) = 0.
+/// So is a run whose time step would need more than `MAX_STEPS` steps.
 pub fn fluid_scheme<const D: usize>(
     scene: &str,
     p: &Params,
@@ -182,6 +209,7 @@ pub fn fluid_scheme<const D: usize>(
             1.0 / kernel.support()
         ));
     }
+    check_step_count(scene, p, h, c)?;
     let all = p.str("corrections") == "all";
     let corrections = Corrections {
         continuity: switch(p, "corr_continuity", all),
