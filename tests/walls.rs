@@ -118,3 +118,25 @@ fn the_dam_break_records_what_the_shifting_does() {
     let last = snapshots.filter(fluid).max().unwrap();
     assert!(std::fs::read_to_string(last).unwrap().contains("Name=\"shift_speed\""));
 }
+
+/// A checkpoint written before a parameter existed (here `wall_pressure`, which such runs
+/// did not record) resumes when the parameter holds its default, the value those runs had:
+/// its cache key is the same, so must its checkpoint be.
+#[test]
+fn a_checkpoint_from_before_a_parameter_existed_resumes() {
+    let sets: Vec<String> = ["nx=10", "tf=0.3"].iter().map(|s| s.to_string()).collect();
+    let params = cavity::ENTRY.params_from_sets(&sets).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let stop = RunOptions { quiet: true, stop_after_steps: Some(20), ..Default::default() };
+    assert!(harness::run(&cavity::ENTRY, &params, dir.path(), &stop).is_err());
+    let path = dir.path().join("checkpoint.json");
+    let mut ckpt: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let recorded = ckpt["params"].as_object_mut().unwrap();
+    assert_eq!(recorded.remove("wall_pressure").unwrap(), "extrapolated");
+    std::fs::write(&path, serde_json::to_vec(&ckpt).unwrap()).unwrap();
+    let quiet = RunOptions { quiet: true, ..Default::default() };
+    let resumed = harness::run(&cavity::ENTRY, &params, dir.path(), &quiet).unwrap();
+    let whole = harness::run(&cavity::ENTRY, &params, tempfile::tempdir().unwrap().path(), &quiet).unwrap();
+    assert_eq!(resumed.steps, whole.steps);
+    assert_eq!(resumed.metrics, whole.metrics, "resumed, not rerun from scratch into other numbers");
+}

@@ -40,15 +40,10 @@ pub fn fingerprint_of_case(scene: &str, params: &BTreeMap<String, serde_json::Va
 /// The parameters in a case's key: all of them but those [added later](crate::scenes::params::Spec::added_later)
 /// at their default, which reproduces the results computed before they existed.
 fn keyed_params(case: &Case) -> BTreeMap<String, serde_json::Value> {
-    let mut params = case.params.to_json();
-    if let Ok(entry) = crate::scenes::find(&case.scene) {
-        for spec in (entry.params)().iter().filter(|s| s.added_later) {
-            if params.get(spec.name) == serde_json::to_value(&spec.default).ok().as_ref() {
-                params.remove(spec.name);
-            }
-        }
+    match crate::scenes::find(&case.scene) {
+        Ok(entry) => case.params.without_later_defaults(&(entry.params)()).to_json(),
+        Err(_) => case.params.to_json(),
     }
-    params
 }
 
 /// The inputs of a case, written to `case.json` in its folder.

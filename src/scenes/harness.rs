@@ -85,8 +85,11 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     // A checkpoint of other parameters is another case's interrupted work: keep it unless
     // asked.
     let ckpt_path = out.join("checkpoint.json");
+    let specs = (entry.params)();
     let checkpoint = match read_checkpoint(&ckpt_path) {
-        Some(c) if c.params == *params => Some(c),
+        Some(c) if c.params.without_later_defaults(&specs) == params.without_later_defaults(&specs) => {
+            Some(c)
+        }
         Some(_) if !opts.force => {
             return Err(RunError::Input(format!(
                 "{} holds an interrupted run of other parameters; pass --force to discard it",

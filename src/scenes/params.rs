@@ -184,6 +184,19 @@ impl Params {
         Self(specs.iter().map(|s| (s.name.to_string(), s.default.clone())).collect())
     }
 
+    /// Without the parameters [added later](Spec::added_later) that hold their default:
+    /// the inputs as a run from before those parameters existed recorded them, so that
+    /// its results (cache keys, checkpoints) stay its own.
+    pub fn without_later_defaults(&self, specs: &[Spec]) -> Self {
+        let mut p = self.clone();
+        for s in specs.iter().filter(|s| s.added_later) {
+            if p.0.get(s.name) == Some(&s.default) {
+                p.0.remove(s.name);
+            }
+        }
+        p
+    }
+
     /// Sets `key` from a string, checked against `specs`.
     pub fn set_str(&mut self, scene: &str, specs: &[Spec], key: &str, value: &str) -> Result<(), String> {
         let spec = find_spec(scene, specs, key, value)?;
