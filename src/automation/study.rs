@@ -234,6 +234,21 @@ fn missing_note(rs: &[Run]) -> String {
     }
 }
 
+/// Why a claim over `rs` cannot be judged: the cases that diverged (a result, but no
+/// metric at the end time), else missing results.
+fn unjudged(f: &Figure, rs: &[Run]) -> String {
+    let diverged: Vec<String> = rs
+        .iter()
+        .filter(|r| r.summary.as_ref().is_some_and(|s| s.status == Status::Diverged))
+        .map(|r| label(r.case, &f.label))
+        .collect();
+    if diverged.is_empty() {
+        "results are missing".into()
+    } else {
+        format!("diverged before the end time: {}", diverged.join(", "))
+    }
+}
+
 /// Numbers per case and the verdict on the figure's claim.
 fn ours(f: &Figure, rs: &[Run]) -> String {
     let Some(m) = &f.metric else {
@@ -261,7 +276,7 @@ fn ours(f: &Figure, rs: &[Run]) -> String {
         pts.sort_by(|a, b| a.0.total_cmp(&b.0));
         let vals: Vec<f64> = pts.iter().filter_map(|x| x.1).collect();
         if vals.len() < pts.len() || vals.len() < 2 {
-            text += " The convergence claim cannot be judged: results are missing.";
+            text += &format!(" The convergence claim cannot be judged: {}.", unjudged(f, rs));
         } else if vals.windows(2).all(|w| w[1] < w[0]) {
             text += &format!(" Reproduced: `{m}` decreases as `{key}` grows.");
         } else {
@@ -288,7 +303,7 @@ fn ours(f: &Figure, rs: &[Run]) -> String {
                     fmt(b)
                 )
             }
-            _ => text += " The claim cannot be judged: results are missing.",
+            _ => text += &format!(" The claim cannot be judged: {}.", unjudged(f, rs)),
         }
     }
     text + &missing_note(rs)
@@ -781,6 +796,29 @@ paper = "Fig. 14a"
         assert!(!svg.contains("nx = 16"));
         let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
         assert!(ours.contains("No result for: nx16"), "{ours}");
+        assert!(ours.contains("cannot be judged: results are missing"), "{ours}");
+
+        // A diverged case is a result without metrics: the claim names it.
+        Summary {
+            scene: "taylor_green".into(),
+            params: p.cases[1].params.to_json(),
+            particles: 256,
+            steps: 4,
+            final_time: 0.19,
+            wall_seconds: 0.1,
+            particle_steps_per_second: 1.0,
+            threads: 1,
+            status: Status::Diverged,
+            reason: Some("NaN".into()),
+            step: Some(4),
+            metrics: BTreeMap::new(),
+            provenance: Provenance::now(chrono::Utc::now()),
+        }
+        .write(&e.dir)
+        .unwrap();
+        let section = regenerate(&p, &output, &manuscript).unwrap();
+        let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
+        assert!(ours.contains("cannot be judged: diverged before the end time: nx = 16"), "{ours}");
     }
 
     /// A finished case with snapshots at t = 0, 0.5004 and 1.0 (pressure 0, 1, 2 and a
