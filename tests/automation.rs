@@ -55,6 +55,21 @@ impl Env {
             .unwrap_or_else(|| panic!("no folder for case {name}"))
     }
 
+    /// The `progress` file of the first case that writes one (its simulation is stepping).
+    fn progress_file(&self) -> PathBuf {
+        let t0 = std::time::Instant::now();
+        loop {
+            let p = std::fs::read_dir(self.root.join("output/tiny")).ok().and_then(|mut d| {
+                d.find_map(|e| e.ok().map(|e| e.path().join("progress")).filter(|p| p.exists()))
+            });
+            if let Some(p) = p {
+                return p;
+            }
+            assert!(t0.elapsed().as_secs() < 60, "no progress file");
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+    }
+
     fn summary(&self, name: &str) -> serde_json::Value {
         let s = std::fs::read_to_string(self.case_dir(name).join("summary.json")).unwrap();
         serde_json::from_str(&s).unwrap()
@@ -64,6 +79,15 @@ impl Env {
 fn text(o: &Output) -> String {
     format!("{}{}", String::from_utf8_lossy(&o.stdout), String::from_utf8_lossy(&o.stderr))
 }
+
+/// One case that runs for seconds, to be interrupted.
+const ONE_SLOW_CASE: &str = r#"title = "one slow case"
+scene = "taylor_green"
+[presets.quick]
+[[cases]]
+name = "a"
+params = { nx = 16, tf = 20.0 }
+"#;
 
 /// Three named cases at nx = 12/14/16, tf as given.
 fn three_cases(tf: f64) -> String {
@@ -170,28 +194,10 @@ max = 1e300
 #[test]
 fn a_killed_run_is_not_done_and_is_repeated() {
     use std::os::unix::process::CommandExt;
-    let env = Env::new(
-        r#"title = "one slow case"
-scene = "taylor_green"
-[presets.quick]
-[[cases]]
-name = "a"
-params = { nx = 16, tf = 20.0 }
-"#,
-    );
+    let env = Env::new(ONE_SLOW_CASE);
     let mut child = env.cmd(&["run", "tiny", "--jobs", "1"]).process_group(0).spawn().unwrap();
     // Wait until the simulation reports progress, then kill runner and case at once.
-    let t0 = std::time::Instant::now();
-    let progress = loop {
-        let p = std::fs::read_dir(env.root.join("output/tiny")).ok().and_then(|mut d| {
-            d.find_map(|e| e.ok().map(|e| e.path().join("progress")).filter(|p| p.exists()))
-        });
-        if let Some(p) = p {
-            break p;
-        }
-        assert!(t0.elapsed().as_secs() < 60, "no progress file");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    };
+    let progress = env.progress_file();
     let pgid = child.id();
     Command::new("kill").args(["-KILL", "--", &format!("-{pgid}")]).status().unwrap();
     let _ = child.wait();
@@ -210,32 +216,14 @@ params = { nx = 16, tf = 20.0 }
 }
 
 /// A runner killed outright (SIGKILL, its simulation spared) does not leave the
-/// simulation running on its own: it stops with a checkpoint (Linux: it gets SIGTERM), and
+/// simulation running on its own: it stops with a checkpoint (Linux: it gets SIGUSR1), and
 /// the next run resumes it.
 #[cfg(target_os = "linux")]
 #[test]
 fn a_killed_runner_takes_its_simulation_with_it() {
-    let env = Env::new(
-        r#"title = "one slow case"
-scene = "taylor_green"
-[presets.quick]
-[[cases]]
-name = "a"
-params = { nx = 16, tf = 20.0 }
-"#,
-    );
+    let env = Env::new(ONE_SLOW_CASE);
     let mut runner = env.cmd(&["run", "tiny", "--jobs", "1"]).spawn().unwrap();
-    let t0 = std::time::Instant::now();
-    let progress = loop {
-        let p = std::fs::read_dir(env.root.join("output/tiny")).ok().and_then(|mut d| {
-            d.find_map(|e| e.ok().map(|e| e.path().join("progress")).filter(|p| p.exists()))
-        });
-        if let Some(p) = p {
-            break p;
-        }
-        assert!(t0.elapsed().as_secs() < 60, "no progress file");
-        std::thread::sleep(std::time::Duration::from_millis(50));
-    };
+    let progress = env.progress_file();
     runner.kill().unwrap();
     let _ = runner.wait();
     let dir = progress.parent().unwrap();
