@@ -162,7 +162,7 @@ fn edit_reruns_exactly_the_edited_case_and_check_enforces_bounds() {
 }
 
 /// A diverged case is done (a result, not rerun) but breaches every bound on it, even one
-/// its metrics would meet: they are those of the moment it blew up.
+/// no value could breach, and the breach says where it blew up.
 #[test]
 fn a_diverged_case_is_done_but_breaches_its_bounds() {
     let env = Env::new(

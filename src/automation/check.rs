@@ -17,9 +17,8 @@ pub struct Breach {
 
 /// Checks every bound of `problems` against the results under `output`. Returns the
 /// number of (bound, case) pairs that hold and every breach; a missing or unfinished
-/// result is a breach, and so is a diverged one: its metrics are those of the moment it
-/// blew up, so a bound on them would hold by accident (a lost-particle count of 0 at the
-/// step the fields turned NaN).
+/// result is a breach, and so is a diverged one, named as such with where it blew up (it
+/// has no metrics at the end time to compare).
 pub fn check(output: &Path, problems: &[Problem]) -> (usize, Vec<Breach>) {
     let mut ok = 0;
     let mut bad = Vec::new();
