@@ -262,6 +262,40 @@ fn a_case_that_would_step_forever_is_refused_before_anything_runs() {
     assert!(!env.root.join("output").exists(), "{t}");
 }
 
+/// Another preset's current result of a case of the same name is not an earlier input of
+/// it: the paper preset's first run calls the case missing, not stale.
+#[test]
+fn another_presets_result_does_not_make_a_case_stale() {
+    let env = Env::new(
+        r#"title = "two presets"
+scene = "taylor_green"
+[params]
+nx = 12
+tf = "$tf"
+[presets.quick]
+tf = 0.02
+[presets.paper]
+tf = 0.03
+[[cases]]
+name = "a"
+"#,
+    );
+    assert!(env.run(&["run", "tiny"]).status.success());
+    let o = env.run(&["run", "tiny", "--preset", "paper", "--dry-run"]);
+    let t = text(&o);
+    assert!(t.contains("would run tiny/a (missing)"), "{t}");
+    let t = text(&env.run(&["status", "--preset", "paper"]));
+    assert!(
+        t.contains("missing    a\n") && !t.contains("inputs changed") && t.contains("other preset"),
+        "{t}"
+    );
+    // An edit of the quick preset's own input still makes its case stale.
+    let src = std::fs::read_to_string(env.root.join("problems/tiny.toml")).unwrap();
+    std::fs::write(env.root.join("problems/tiny.toml"), src.replace("tf = 0.02", "tf = 0.025")).unwrap();
+    let t = text(&env.run(&["run", "tiny", "--dry-run"]));
+    assert!(t.contains("would run tiny/a (stale: tf 0.02 -> 0.025)"), "{t}");
+}
+
 /// `--plot-only` never draws over the figures of a problem with nothing (a mistyped
 /// --output, a fresh checkout): it names the problem, writes nothing and exits 1.
 #[test]

@@ -8,8 +8,9 @@ use super::registry::{Case, Problem};
 use crate::solver::output::summary::{Status, Summary, PART_VERSIONS, SCHEME_VERSION};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The solver fingerprint: crate version and scheme version.
 pub fn fingerprint() -> String {
@@ -134,7 +135,8 @@ pub enum State {
     Done(Status),
     /// A folder with a `failed` summary, or none (killed, crashed).
     Failed(String),
-    /// No folder. If a folder of the same case name with another key exists, the change.
+    /// No folder. If a folder of the same case name with other inputs exists (not the
+    /// current result of another preset), the change: the case is stale.
     Missing(Option<String>),
 }
 
@@ -147,6 +149,9 @@ pub struct Entry {
     pub record: CaseRecord,
     /// Its folder.
     pub dir: PathBuf,
+    /// The folders of the current cases of the problem's other presets (filled by
+    /// [`entries`]): their results are not earlier inputs of this case.
+    others: Arc<HashSet<PathBuf>>,
 }
 
 impl Entry {
@@ -154,7 +159,7 @@ impl Entry {
     pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
         let record = CaseRecord::new(&problem.name, case);
         let dir = output.join(&problem.name).join(record.folder());
-        Self { case: case.clone(), record, dir }
+        Self { case: case.clone(), record, dir, others: Arc::default() }
     }
 
     /// The summary, if there is a readable one.
@@ -177,8 +182,8 @@ impl Entry {
         matches!(self.state(), State::Done(_))
     }
 
-    /// If other folders hold this case name with other keys, what changed from the nearest
-    /// of them (the fewest changes, then the first by name, so that the answer does not
+    /// If other folders hold this case name with other keys (other than the other presets'
+    /// current results), what changed from the nearest of them (the fewest changes, then the first by name, so that the answer does not
     /// depend on the order the system lists the folder in).
     fn previous_change(&self) -> Option<String> {
         let parent = self.dir.parent()?;
@@ -188,7 +193,7 @@ impl Entry {
             let Some((case, _)) = name.rsplit_once('-') else {
                 continue;
             };
-            if case != self.record.name || e.path() == self.dir {
+            if case != self.record.name || e.path() == self.dir || self.others.contains(&e.path()) {
                 continue;
             }
             if let Some(old) = read_record(&e.path()) {
@@ -218,7 +223,15 @@ pub fn read_record(dir: &Path) -> Option<CaseRecord> {
 
 /// Every case of `problem` with its cache entry.
 pub fn entries(output: &Path, problem: &Problem) -> Vec<Entry> {
-    problem.cases.iter().map(|c| Entry::new(output, problem, c)).collect()
+    let others: Arc<HashSet<PathBuf>> = Arc::new(
+        problem
+            .other_presets
+            .iter()
+            .flat_map(|(_, cases)| cases)
+            .map(|c| Entry::new(output, problem, c).dir)
+            .collect(),
+    );
+    problem.cases.iter().map(|c| Entry { others: others.clone(), ..Entry::new(output, problem, c) }).collect()
 }
 
 /// Folders under `OUTPUT/<problem>/` that belong to no case of `problems` (in any of the
