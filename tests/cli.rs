@@ -311,3 +311,55 @@ fn bench_repeats_every_case_and_reports_the_median_run() {
     assert!(!out.status.success());
     assert!(String::from_utf8_lossy(&out.stderr).contains("--repeat"));
 }
+
+/// SIGTERM and SIGHUP stop a run as Ctrl-C does (a checkpoint, a `failed` summary), but a
+/// SIGHUP ignored by whoever started it (`nohup`) stays ignored.
+#[cfg(unix)]
+#[test]
+fn sigterm_and_sighup_stop_a_run_with_a_checkpoint_unless_hup_is_ignored() {
+    use std::os::unix::process::CommandExt;
+    let start = |dir: &Path, ignore_hup: bool| {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_sphrepro"));
+        c.args(["simulate", "taylor_green", "--quiet", "--set", "nx=24", "--set", "tf=50"]);
+        c.arg("--out").arg(dir).arg("--progress-file").arg(dir.join("progress"));
+        if ignore_hup {
+            // SAFETY: only `signal` between fork and exec, async-signal-safe.
+            unsafe {
+                c.pre_exec(|| {
+                    libc::signal(libc::SIGHUP, libc::SIG_IGN);
+                    Ok(())
+                });
+            }
+        }
+        let child = c.spawn().unwrap();
+        let t0 = Instant::now();
+        while !dir.join("progress").exists() {
+            assert!(t0.elapsed() < Duration::from_secs(60), "no progress");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        child
+    };
+    let signal = |child: &std::process::Child, sig: &str| {
+        Command::new("kill").args([sig, &child.id().to_string()]).status().unwrap();
+    };
+    let stopped = |dir: &Path| {
+        let s: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+        s["status"] == "failed" && dir.join("checkpoint.json").exists()
+    };
+    for sig in ["-TERM", "-HUP"] {
+        let dir = tempfile::tempdir().unwrap();
+        let mut child = start(dir.path(), false);
+        signal(&child, sig);
+        assert_eq!(child.wait().unwrap().code(), Some(1), "{sig}");
+        assert!(stopped(dir.path()), "{sig}");
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = start(dir.path(), true);
+    signal(&child, "-HUP");
+    std::thread::sleep(Duration::from_millis(500));
+    assert!(child.try_wait().unwrap().is_none(), "an ignored SIGHUP stopped the run");
+    signal(&child, "-TERM");
+    assert_eq!(child.wait().unwrap().code(), Some(1));
+    assert!(stopped(dir.path()));
+}
