@@ -365,7 +365,7 @@ pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize
 }
 
 /// The [`SceneRun`](super::SceneRun) methods every scene forwards to its `sim` field
-/// (a `Simulation<D>`): particle count, time, steps, the time step, advancing.
+/// (a `Simulation<D>`): particle count, time, steps, advancing.
 macro_rules! forward_to_sim {
     () => {
         fn particles(&self) -> usize {
@@ -376,9 +376,6 @@ macro_rules! forward_to_sim {
         }
         fn steps(&self) -> u64 {
             self.sim.steps()
-        }
-        fn time_step_limit(&self) -> ($crate::solver::integrator::TimeStepLimit, f64) {
-            self.sim.time_step_limit()
         }
         fn advance(
             &mut self,

@@ -27,8 +27,6 @@ pub trait SceneRun {
     fn time(&self) -> f64;
     /// Steps taken.
     fn steps(&self) -> u64;
-    /// The limit of CTVF eq. (61) that sets the next time step, and the step.
-    fn time_step_limit(&self) -> (crate::solver::integrator::TimeStepLimit, f64);
     /// The plan (bodies, scheme and terms), written at the top of the run log.
     fn plan(&self) -> String;
     /// Steps until the time reaches `t_stop` (steps are not shortened for it) without

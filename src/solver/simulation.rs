@@ -1,6 +1,6 @@
 //! A simulation: a domain, the bodies, a scheme and the kick-drift-kick loop.
 
-use crate::solver::integrator::{self, RatePositions, TimeStepLimit};
+use crate::solver::integrator::{self, RatePositions};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
@@ -280,15 +280,10 @@ impl<const D: usize> Simulation<D> {
 
     /// The time step of eq. (61) from the current largest speed.
     pub fn nominal_dt(&self) -> f64 {
-        self.time_step_limit().1
-    }
-
-    /// The limit of eq. (61) that sets [`nominal_dt`](Self::nominal_dt), and its value.
-    pub fn time_step_limit(&self) -> (TimeStepLimit, f64) {
         let s = &self.state.scheme;
         let g = s.gravity.iter().map(|v| v * v).sum::<f64>().sqrt();
         let ts = &self.time_settings;
-        integrator::binding_limit(
+        integrator::time_step(
             ts.cfl,
             self.state.fluid.h,
             ts.c0,
