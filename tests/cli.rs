@@ -10,6 +10,11 @@ fn sphrepro(args: &[&str]) -> (i32, String) {
     (out.status.code().unwrap_or(-1), String::from_utf8_lossy(&out.stderr).into_owned())
 }
 
+/// `DIR/summary.json`.
+fn summary(dir: &Path) -> serde_json::Value {
+    serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap()
+}
+
 fn simulate(dir: &Path, scene: &str, sets: &[&str]) -> (i32, String) {
     let mut args = vec!["simulate", scene, "--quiet", "--out", dir.to_str().unwrap()];
     for s in sets {
@@ -76,8 +81,7 @@ fn a_blow_up_ends_diverged_with_a_reason_and_a_non_zero_exit() {
     let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "cfl=5", "tf=1.0"]);
     assert!(t0.elapsed() < Duration::from_secs(60), "took {:?}", t0.elapsed());
     assert_eq!(code, 3, "stderr: {err}");
-    let s: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let s = summary(dir.path());
     assert_eq!(s["status"], "diverged");
     assert!(!s["reason"].as_str().unwrap().is_empty());
     assert!(s["step"].as_u64().unwrap() > 0);
@@ -100,8 +104,7 @@ fn a_run_that_grows_without_turning_nan_ends_diverged_at_mach_one() {
     let dir = tempfile::tempdir().unwrap();
     let (code, err) = simulate(dir.path(), "taylor_green", &["nx=8", "scheme=edac", "cfl=5", "tf=1.0"]);
     assert_eq!(code, 3, "stderr: {err}");
-    let s: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let s = summary(dir.path());
     assert_eq!(s["status"], "diverged");
     let reason = s["reason"].as_str().unwrap();
     assert!(reason.contains("exceeds 1 c0"), "{reason}");
@@ -134,8 +137,7 @@ fn a_finished_run_is_not_overwritten_without_force() {
         .status()
         .unwrap();
     assert!(out.success());
-    let s: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let s = summary(dir.path());
     assert_eq!(s["params"]["tf"], 0.04);
 }
 
@@ -144,8 +146,7 @@ fn a_completed_run_writes_the_contracted_outputs() {
     let dir = tempfile::tempdir().unwrap();
     let (code, err) = simulate(dir.path(), "taylor_green", &["nx=16", "tf=0.05", "scheme=ctvf", "pst=ipst"]);
     assert_eq!(code, 0, "{err}");
-    let s: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.path().join("summary.json")).unwrap()).unwrap();
+    let s = summary(dir.path());
     for k in [
         "scene",
         "params",
@@ -343,8 +344,7 @@ fn sigterm_and_sighup_stop_a_run_with_a_checkpoint_unless_hup_is_ignored() {
         Command::new("kill").args([sig, &child.id().to_string()]).status().unwrap();
     };
     let stopped = |dir: &Path| {
-        let s: serde_json::Value =
-            serde_json::from_slice(&std::fs::read(dir.join("summary.json")).unwrap()).unwrap();
+        let s = summary(dir);
         s["status"] == "failed" && dir.join("checkpoint.json").exists()
     };
     for sig in ["-TERM", "-HUP"] {
