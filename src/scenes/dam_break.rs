@@ -124,6 +124,10 @@ fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), Strin
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    Ok(Box::new(dam_break(p)?))
+}
+
+fn dam_break(p: &Params) -> Result<DamBreak, String> {
     let (dx, l, hc) = (p.float("dx"), p.float("column_width"), p.float("column_height"));
     let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let (constants, kernel, h, scheme) = setup(p)?;
@@ -143,7 +147,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let time = time_settings(p, c0, u_ref);
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `dam_break`: {e}"))?;
-    Ok(Box::new(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() }))
+    Ok(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() })
 }
 
 impl DamBreak {
@@ -228,6 +232,36 @@ impl SceneRun for DamBreak {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::scheme::WallSet;
+
+    /// The walls' pressure (eqs. 46-52) is summed from the fluid pressure that the
+    /// accelerations use: after the surface particles are set to p = 0, not before.
+    #[test]
+    fn the_walls_see_the_surface_pressure_the_accelerations_use() {
+        let specs = params();
+        let mut p = Params::defaults(&specs);
+        for (key, value) in [("dx", "0.1"), ("surface_pressure", "zero"), ("wall_pressure", "extrapolated")] {
+            p.set_str("dam_break", &specs, key, value).unwrap();
+        }
+        let mut run = dam_break(&p).unwrap();
+        for _ in 0..50 {
+            run.sim.step(f64::INFINITY).unwrap();
+        }
+        let sim = &run.sim;
+        let (fluid, walls) = (sim.fluid(), sim.walls.as_ref().unwrap());
+        let surface = &sim.surface.as_ref().unwrap().surface;
+        assert!(fluid.p.iter().zip(surface).all(|(&p, &s)| !s || p == 0.0), "surface particles at p = 0");
+        // The test needs surface particles within a wall particle's support.
+        let reach = sim.kernel.support() * fluid.h;
+        let touching = (0..fluid.len())
+            .filter(|&i| surface[i] && walls.wall.x.iter().any(|w| (w - fluid.x[i]).norm() < reach))
+            .count();
+        assert!(touching > 0, "no surface particle near a wall");
+        let mut fresh = walls.clone();
+        fresh.extrapolate(fluid, sim.state.scheme.gravity_vector());
+        let bits = |w: &WallSet<2>| w.wall.ghost.iter().map(|g| g.p.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(walls), bits(&fresh));
+    }
 
     #[test]
     fn koshizuka_points_parse() {

@@ -84,14 +84,17 @@ fn half_kick<const D: usize>(u: &mut Vector<D>, du: &Vector<D>, dt: f64) {
 }
 
 /// The half kick (eq. 54) and, if the body has one, the transport velocity
-/// `u~ = u + dt/2 (du/dt)_c` (eq. 55).
+/// `u~ = u + dt_c/2 (du/dt)_c` (eq. 55), `dt_c` the step a shifting technique scaled
+/// (du/dt)_c for (`a_c_dt`; `dt` itself for a background pressure).
 pub fn kick_transport<const D: usize>(
     u: &mut [Vector<D>],
     u_hat: Option<&mut [Vector<D>]>,
     du: &[Vector<D>],
     a_c: &[Vector<D>],
+    a_c_dt: Option<f64>,
     dt: f64,
 ) {
+    let half_dt_c = 0.5 * a_c_dt.unwrap_or(dt);
     // Zipped iterators stop at the shortest slice: every one must cover the body.
     assert!(du.len() == u.len(), "one rate per particle");
     match u_hat {
@@ -100,7 +103,7 @@ pub fn kick_transport<const D: usize>(
             u.par_iter_mut().zip(u_hat).zip(du).zip(a_c).with_min_len(LIGHT_LOOP_LEN).for_each(
                 |(((u, uh), du), ac)| {
                     half_kick(u, du, dt);
-                    *uh = *u + ac * (0.5 * dt);
+                    *uh = *u + ac * half_dt_c;
                 },
             )
         }

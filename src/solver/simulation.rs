@@ -7,7 +7,7 @@ use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
     build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, DensityModel, FluidPasses,
-    FluidScheme, KernelList, PressureModel, Shifting, SurfaceFields, WallSet,
+    FluidScheme, KernelList, PressureModel, Shifting, SurfaceFields, SurfacePressure, WallSet,
 };
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -268,13 +268,14 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    /// Each fluid particle's shifting speed in the coming step, |u~ - u| = dt/2 |(du/dt)_c|
-    /// (eq. 55, dt the nominal step of eq. 61): how fast the shifting moves it relative to
-    /// the flow; `None` without a transport velocity. (The stored u~ is of the last half
-    /// step and u of the full step, so their difference also holds dt/2 du/dt.)
+    /// Each fluid particle's shifting speed in the coming step, |u~ - u| = dt_c/2 |(du/dt)_c|
+    /// (eq. 55, dt_c the step the shifting was scaled for, or the nominal step of eq. 61):
+    /// how fast the shifting moves it relative to the flow; `None` without a transport
+    /// velocity. (The stored u~ is of the last half step and u of the full step, so their
+    /// difference also holds dt/2 du/dt.)
     pub fn shift_speeds(&self) -> Option<Vec<f64>> {
         self.state.fluid.u_hat.as_ref()?;
-        let half_dt = 0.5 * self.nominal_dt();
+        let half_dt = 0.5 * self.state.rates.a_c_dt.unwrap_or_else(|| self.nominal_dt());
         Some(self.state.rates.a_c.iter().map(|a| half_dt * a.norm()).collect())
     }
 
@@ -296,11 +297,17 @@ impl<const D: usize> Simulation<D> {
     /// The accelerations of the state, for step `next_step` (0 the first).
     fn evaluate_accelerations(&mut self, dt_nominal: f64, next_step: u64) {
         let clock = std::time::Instant::now();
-        let (st, walls) = (&mut self.state, self.walls.as_ref());
-        if let (Some(fs), Some(free)) = (self.surface.as_mut(), st.scheme.free_surface) {
-            fs.detect(&st.fluid, &self.neighbours, walls, free.rho0);
+        if let (Some(fs), Some(free)) = (self.surface.as_mut(), self.state.scheme.free_surface) {
+            let st = &mut self.state;
+            fs.detect(&st.fluid, &self.neighbours, self.walls.as_ref(), free.rho0);
             fs.apply_surface_pressure(free.pressure, free.rho0, &mut st.fluid.p);
+            if free.pressure != SurfacePressure::Evolve {
+                // The walls' pressure (eqs. 46-52) sums the fluid's, so it follows the
+                // surface pressures just set: a wall under a splash's front sees p = 0 there.
+                self.extrapolate_walls();
+            }
         }
+        let (st, walls) = (&mut self.state, self.walls.as_ref());
         let surface = self.surface.as_ref();
         self.passes.accelerations(
             &st.fluid,
@@ -354,7 +361,8 @@ impl<const D: usize> Simulation<D> {
         {
             let st = &mut self.state;
             let Fluid { u, u_hat, .. } = &mut st.fluid;
-            integrator::kick_transport(u, u_hat.as_deref_mut(), &st.rates.du, &st.rates.a_c, dt);
+            let r = &st.rates;
+            integrator::kick_transport(u, u_hat.as_deref_mut(), &r.du, &r.a_c, r.a_c_dt, dt);
         }
         let mut clock = lap(clock, &mut self.times.integrate);
         if rates_at == RatePositions::Start {
@@ -502,6 +510,10 @@ mod tests {
     /// A Taylor-Green-like vortex on a perturbed 16x16 lattice in a periodic unit box,
     /// CTVF with IPST, with the rates taken at `rates_at`.
     fn vortex(rates_at: RatePositions) -> Simulation<2> {
+        vortex_with(rates_at, Pst::Ipst)
+    }
+
+    fn vortex_with(rates_at: RatePositions, pst: Pst) -> Simulation<2> {
         let n = 16;
         let dx = 1.0 / n as f64;
         let mut init = FluidInit::<2>::default();
@@ -518,14 +530,44 @@ mod tests {
             }
         }
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
-        let settings = FluidSettings {
-            pst: Pst::Ipst,
-            ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01)
-        };
+        let settings =
+            FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
         let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
         let fluid = Fluid::new("fluid", dx, init, true).unwrap();
         let time = TimeSettings { rate_positions: rates_at, ..TimeSettings::new(0.25, 10.0, 1.0) };
         Simulation::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel, fluid, None, scheme, time).unwrap()
+    }
+
+    /// Eq. (55) with eqs. (36) and (41): the shifting techniques divide (du/dt)_c by the step
+    /// it is evaluated for, so a shorter step (the last before an end time) keeps the
+    /// shifting velocity `dt/2 (du/dt)_c` of that step, not its own `dt'/2 (du/dt)_c`.
+    #[test]
+    fn a_shortened_step_keeps_the_shifting_velocity() {
+        for pst in [Pst::Sun, Pst::Ipst] {
+            let mut sim = vortex_with(RatePositions::End, pst);
+            for _ in 0..5 {
+                sim.step(f64::INFINITY).unwrap();
+            }
+            let dt = sim.nominal_dt();
+            assert_eq!(sim.state.rates.a_c_dt, Some(dt), "{pst:?}: scaled for the nominal step");
+            let before = sim.state.clone();
+            let short = 0.25 * dt;
+            sim.step(short).unwrap();
+            let f = &before.fluid;
+            let (u, du, ac) = (f.by_id(&f.u), f.by_id(&before.rates.du), f.by_id(&before.rates.a_c));
+            let after = &sim.state.fluid;
+            let u_hat = after.by_id(after.u_hat.as_ref().unwrap());
+            let mut largest_shift: f64 = 0.0;
+            for i in 0..u.len() {
+                let expected = u[i] + du[i] * (0.5 * short) + ac[i] * (0.5 * dt);
+                assert!(
+                    (u_hat[i] - expected).norm() <= 1e-14 * expected.norm().max(1.0),
+                    "{pst:?}: particle {i}"
+                );
+                largest_shift = largest_shift.max((ac[i] * (0.5 * dt)).norm());
+            }
+            assert!(largest_shift > 1e-6, "{pst:?}: the test needs a shifting velocity ({largest_shift:e})");
+        }
     }
 
     /// Sec. 3.7: the pressure and density of step n+1 come from the rates at the start
@@ -542,7 +584,8 @@ mod tests {
             let dt = sim.nominal_dt();
             let mut probe = sim.state.clone();
             let Fluid { u, u_hat, .. } = &mut probe.fluid;
-            integrator::kick_transport(u, u_hat.as_deref_mut(), &probe.rates.du, &probe.rates.a_c, dt);
+            let r = &probe.rates;
+            integrator::kick_transport(u, u_hat.as_deref_mut(), &r.du, &r.a_c, r.a_c_dt, dt);
             let walls = sim.walls.as_ref();
             sim.passes.update_density_and_pressure(
                 &mut probe.fluid,

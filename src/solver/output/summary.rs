@@ -48,8 +48,17 @@ pub const SCHEME_VERSION: &str = "4";
 /// part's results change for unchanged parameters: `(parameter, value, version)`. A case
 /// whose parameter has that value has the version in its cache key; every other case keeps
 /// its results. `pst = ipst`, 1: each fluid pair is evaluated once a sweep and added to
-/// both particles (results change by rounding).
-pub const PART_VERSIONS: &[(&str, &str, u32)] = &[("pst", "ipst", 1)];
+/// both particles (results change by rounding). `pst = sun` 1 and `ipst` 2: a step shorter
+/// than the one the shifting was evaluated for (the last before an end time; adaptive steps)
+/// keeps its shifting velocity. `surface_pressure` other than `evolve`, 1: the walls'
+/// pressure is extrapolated from the surface pressures as set, not as evolved.
+pub const PART_VERSIONS: &[(&str, &str, u32)] = &[
+    ("pst", "sun", 1),
+    ("pst", "ipst", 2),
+    ("surface_pressure", "zero", 1),
+    ("surface_pressure", "zero_isolated", 1),
+    ("surface_pressure", "non_negative", 1),
+];
 
 impl Provenance {
     /// Provenance of this binary, for a run that started at `started`.

@@ -62,6 +62,14 @@ pub struct FluidRates<const D: usize> {
     pub drho: Vec<f64>,
     /// Homogenisation acceleration (du/dt)_c (CTVF eqs. 36, 41), when the scheme shifts.
     pub a_c: Vec<Vector<D>>,
+    /// The step that eq. (36) or (41) divided (du/dt)_c by, for a shifting technique
+    /// (`None` for a background pressure, a true acceleration). The kick sets
+    /// `u~ = u + dt_c/2 (du/dt)_c` with this `dt_c` (eq. 55), so that a step shorter than
+    /// the one it was evaluated for (the last before an end time, or one after the speed
+    /// grew) moves the particles with the shifting velocity the technique computed, for its
+    /// own length.
+    #[serde(default)]
+    pub a_c_dt: Option<f64>,
 }
 
 impl<const D: usize> FluidRates<D> {
@@ -72,6 +80,7 @@ impl<const D: usize> FluidRates<D> {
             dp: if pressure { vec![0.0; n] } else { Vec::new() },
             drho: if density { vec![0.0; n] } else { Vec::new() },
             a_c: if transport { vec![Vector::zeros(); n] } else { Vec::new() },
+            a_c_dt: None,
         }
     }
 }

@@ -303,6 +303,7 @@ impl<const D: usize> FluidPasses<D> {
             (acc + g, ac)
         };
         let ipst = matches!(shifting, Some(Shifting::Ipst { .. }));
+        rates.a_c_dt = matches!(shifting, Some(Shifting::Sun2019 { .. })).then_some(dt);
         if transport && !ipst {
             rates
                 .du
@@ -425,6 +426,7 @@ impl<const D: usize> FluidPasses<D> {
             iterations += 1;
         }
         let f = 2.0 / (dt * dt);
+        rates.a_c_dt = Some(dt);
         let (x0, xs) = (&fluid.x, &self.x_shift);
         rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
             *ac = (xs[i] - x0[i]) * f;
