@@ -498,3 +498,25 @@ params = {{ nx = 12 }}
         );
     }
 }
+
+/// A done case whose `timeseries.csv` was damaged by hand: the figure's error names the
+/// file and the command that computes the case again, and that command does.
+#[test]
+fn a_damaged_time_series_names_the_command_that_repairs_it() {
+    let src = three_cases(0.01).replace("BOUND", "1.0")
+        + "[[figures]]\nid = \"l1\"\nkind = \"timeseries\"\ntitle = \"L1\"\ny = \"l1_velocity\"\n";
+    let env = Env::new(&src);
+    let o = env.run(&["run", "tiny"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let series = env.case_dir("b").join("timeseries.csv");
+    let mut damaged = std::fs::read_to_string(&series).unwrap();
+    damaged.push_str("1,2\n");
+    std::fs::write(&series, damaged).unwrap();
+    let o = env.run(&["run", "tiny"]);
+    let t = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{t}");
+    assert!(t.contains("b-") && t.contains("`sphrepro run tiny --match b --force`"), "{t}");
+    let o = env.run(&["run", "tiny", "--match", "b", "--force"]);
+    let t = text(&o);
+    assert!(o.status.success() && t.contains("1 case(s) to run"), "{t}");
+}

@@ -278,7 +278,10 @@ mod tests {
         let tg = crate::scenes::find("taylor_green").unwrap();
         assert!(tg.outputs > 0 && fingerprint_of("taylor_green") != fingerprint());
         // (and the default `pst = sun` adds its part's version)
-        assert_eq!(CaseRecord::new("p", &case(16)).solver, format!("{}+sun1", fingerprint_of("taylor_green")));
+        assert_eq!(
+            CaseRecord::new("p", &case(16)).solver,
+            format!("{}+sun1", fingerprint_of("taylor_green"))
+        );
     }
 
     /// A parameter added later leaves the keys of the cases at its default as they were

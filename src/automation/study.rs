@@ -66,9 +66,14 @@ fn fmt(x: f64) -> String {
     format!("{x:.3e}")
 }
 
-/// Reads columns `t` and `y` of a case's `timeseries.csv`.
-fn timeseries(dir: &Path, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
-    columns(&dir.join("timeseries.csv"), "t", y)
+/// Reads columns `t` and `y` of a case's `timeseries.csv`; an unreadable one is a damaged
+/// result, which the error says how to compute again.
+fn timeseries(p: &Problem, r: &Run, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
+    columns(&r.entry.dir.join("timeseries.csv"), "t", y).map_err(|e| {
+        let preset = if p.preset == "quick" { String::new() } else { format!(" --preset {}", p.preset) };
+        let (problem, case) = (&p.name, &r.case.name);
+        format!("{e} (a damaged result: `sphrepro run {problem}{preset} --match {case} --force` computes it again)")
+    })
 }
 
 /// Reads columns `x` and `y` of a CSV file (unparsable values are NaN).
@@ -330,10 +335,10 @@ fn figure(
         FigureKind::Timeseries { y, exact } => {
             let mut series = Vec::new();
             for r in rs.iter().filter(|r| r.entry.dir.join("timeseries.csv").exists()) {
-                let (t, v) = timeseries(&r.entry.dir, y)?;
+                let (t, v) = timeseries(p, r, y)?;
                 if series.is_empty() {
                     if let Some(ex) = exact {
-                        let (t, v) = timeseries(&r.entry.dir, ex)?;
+                        let (t, v) = timeseries(p, r, ex)?;
                         series.push(Series { label: "exact".into(), x: t, y: v, style: SeriesStyle::Dashed });
                     }
                 }
