@@ -183,8 +183,9 @@ impl Entry {
     }
 
     /// If other folders hold this case name with other keys (other than the other presets'
-    /// current results), what changed from the nearest of them (the fewest changes, then the first by name, so that the answer does not
-    /// depend on the order the system lists the folder in).
+    /// current results), what changed from the nearest of them (the fewest changes, then
+    /// the first by name, so that the answer does not depend on the order the system lists
+    /// the folder in).
     fn previous_change(&self) -> Option<String> {
         let parent = self.dir.parent()?;
         let mut found: Vec<(Vec<String>, String)> = Vec::new();

@@ -303,7 +303,10 @@ impl<const D: usize> FluidPasses<D> {
             (acc + g, ac)
         };
         let ipst = matches!(shifting, Some(Shifting::Ipst { .. }));
-        rates.a_c_dt = matches!(shifting, Some(Shifting::Sun2019 { .. })).then_some(dt);
+        // Both shifting techniques divide (du/dt)_c by this step (eqs. 36, 41); IPST's pass
+        // below is evaluated with the same one.
+        rates.a_c_dt =
+            matches!(shifting, Some(Shifting::Sun2019 { .. } | Shifting::Ipst { .. })).then_some(dt);
         if transport && !ipst {
             rates
                 .du
@@ -426,7 +429,6 @@ impl<const D: usize> FluidPasses<D> {
             iterations += 1;
         }
         let f = 2.0 / (dt * dt);
-        rates.a_c_dt = Some(dt);
         let (x0, xs) = (&fluid.x, &self.x_shift);
         rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
             *ac = (xs[i] - x0[i]) * f;
