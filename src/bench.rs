@@ -268,6 +268,25 @@ fn millions(speed: f64, runs: &[f64]) -> String {
     }
 }
 
+/// The ratio `a / b` of two throughputs, as `digits` decimals and a `suffix`: with as many
+/// runs of each (`bench --repeat`, one of each per round), the median of the rounds' own
+/// ratios with their range, since a slow spell of a noisy machine that falls on both runs
+/// of a round cancels in their ratio, and the range shows how far a target holds; otherwise
+/// the ratio of the two (median) runs.
+fn ratio(a: (f64, &[f64]), b: (f64, &[f64]), digits: usize, suffix: &str) -> String {
+    let (a_runs, b_runs) = (a.1, b.1);
+    if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
+        return format!("{:.digits$}{suffix}", a.0 / b.0);
+    }
+    let mut rounds: Vec<f64> = a_runs.iter().zip(b_runs).map(|(a, b)| a / b).collect();
+    rounds.sort_by(f64::total_cmp);
+    let (lo, hi) = (rounds[0], rounds[rounds.len() - 1]);
+    // Of an even count, the mean of the two middle ratios (neither favoured).
+    let n = rounds.len();
+    let median = (rounds[(n - 1) / 2] + rounds[n / 2]) / 2.0;
+    format!("{median:.digits$}{suffix} ({lo:.digits$}-{hi:.digits$})")
+}
+
 /// The benchmark table as Markdown (throughput of the median run, with the range over the
 /// runs when there were several), with the throughput of each variant relative to
 /// `edac` on the same size and threads, and the two-thread speed-up; with peer results, the
@@ -275,7 +294,7 @@ fn millions(speed: f64, runs: &[f64]) -> String {
 /// peer's run at [`FIGURE_TO_BEAT_NX`] on the same threads (the issue states one figure to
 /// beat, PySPH at nx = 50, and targets multiples of it at every size; this column reads the targets that
 /// way, the one before it against the peer at each size), and both L1 velocity errors at
-/// the peer's end time.
+/// the peer's end time. Ratios of repeated runs are those of each round (see [`ratio`]).
 pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
         "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
@@ -293,12 +312,17 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     for r in results {
         let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
         let one = results.iter().find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
-        let cost = edac
-            .map(|e| format!("{:.2}", e.particle_steps_per_second / r.particle_steps_per_second))
-            .unwrap_or_default();
+        fn speed_of(r: &BenchResult) -> (f64, &[f64]) {
+            (r.particle_steps_per_second, &r.runs)
+        }
+        let ours = speed_of(r);
+        let cost = match edac {
+            Some(e) if std::ptr::eq(e, r) => "1.00".to_string(),
+            Some(e) => ratio(speed_of(e), ours, 2, ""),
+            None => String::new(),
+        };
         let speedup = if r.threads > 1 {
-            one.map(|o| format!("{:.2}", r.particle_steps_per_second / o.particle_steps_per_second))
-                .unwrap_or_default()
+            one.map(|o| ratio(ours, speed_of(o), 2, "")).unwrap_or_default()
         } else {
             String::new()
         };
@@ -346,14 +370,14 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
                         .iter()
                         .find(|q| q.nx == FIGURE_TO_BEAT_NX && q.threads == r.threads)
                         .map_or(String::new(), |q| {
-                            format!("{:.1}x", r.particle_steps_per_second / q.particle_steps_per_second)
+                            ratio(ours, (q.particle_steps_per_second, &q.runs), 1, "x")
                         });
+                    let to_peer = ratio(ours, (p.particle_steps_per_second, &p.runs), 1, "x");
                     s.insert_str(
                         s.len() - 1,
                         &format!(
-                            " {} | {:.1}x | {at_50} | {l1} |",
-                            millions(p.particle_steps_per_second, &p.runs),
-                            r.particle_steps_per_second / p.particle_steps_per_second
+                            " {} | {to_peer} | {at_50} | {l1} |",
+                            millions(p.particle_steps_per_second, &p.runs)
                         ),
                     )
                 }
@@ -459,13 +483,23 @@ mod peer_tests {
         let t = table(&r, &[]);
         let rows: Vec<&str> = t.lines().collect();
         assert!(rows[2].contains("| 2.000 (1.000-3.000) | 500 |"), "{}", rows[2]);
-        // The speed-up and the cost compare the median runs.
+        // The speed-up compares the runs of each round: 5/3, 6/1 and 4/2, median 2 (the
+        // ratio of the median runs would be 2.5).
         assert!(
-            rows[3].contains("| 5.000 (4.000-6.000) | 200 |") && rows[3].contains("| 1.00 | 2.50 |"),
+            rows[3].contains("| 5.000 (4.000-6.000) | 200 |")
+                && rows[3].contains("| 1.00 | 2.00 (1.67-6.00) |"),
             "{}",
             rows[3]
         );
+        // With one run against three, the cost compares the median runs.
         assert!(rows[4].contains("| 1.000 | 1000 |") && rows[4].contains("| 2.00 |"), "{}", rows[4]);
+        // Two configurations of three rounds each: the median of the rounds' costs.
+        let ipst = BenchResult { runs: vec![1.0e6, 0.25e6, 1.0e6], ..sample("ctvf+ipst", 100, 1, 1.0e6) };
+        let t = table(&[r[0].clone(), ipst], &[]);
+        // 3/1, 1/0.25, 2/1
+        assert!(t.lines().nth(3).unwrap().contains("| 3.00 (2.00-4.00) |"), "{t}");
+        // Of an even count of rounds, the mean of the two middle ratios.
+        assert_eq!(ratio((2.0, &[2.0, 4.0]), (1.0, &[1.0, 1.0]), 1, "x"), "3.0x (2.0-4.0)");
     }
 
     #[test]

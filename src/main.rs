@@ -114,7 +114,9 @@ struct BenchArgs {
     steps: Option<u64>,
     /// Runs of every case and of the peer, in as many rounds over all of them (so that a
     /// slow spell of the machine falls on every variant and on the peer alike); the
-    /// table gives the median run and the range, the JSON every run's throughput.
+    /// table gives the median run and the range, and every ratio (cost, speed-up, to the
+    /// peer) as the median of the rounds' own ratios and their range; the JSON every run's
+    /// throughput.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     repeat: u32,
     /// Where to write the results as JSON.
