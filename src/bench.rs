@@ -117,7 +117,9 @@ pub trait Repeated: Clone {
     fn key(&self) -> Self::Key;
     /// Its particle-steps per second.
     fn speed(&self) -> f64;
-    /// The throughputs of every run of its configuration.
+    /// The throughputs of every run of its configuration (after [`median_runs`]).
+    fn runs(&self) -> &[f64];
+    /// The same, to be set.
     fn runs_mut(&mut self) -> &mut Vec<f64>;
 }
 
@@ -128,6 +130,9 @@ impl Repeated for BenchResult {
     }
     fn speed(&self) -> f64 {
         self.particle_steps_per_second
+    }
+    fn runs(&self) -> &[f64] {
+        &self.runs
     }
     fn runs_mut(&mut self) -> &mut Vec<f64> {
         &mut self.runs
@@ -141,6 +146,9 @@ impl Repeated for PeerResult {
     }
     fn speed(&self) -> f64 {
         self.particle_steps_per_second
+    }
+    fn runs(&self) -> &[f64] {
+        &self.runs
     }
     fn runs_mut(&mut self) -> &mut Vec<f64> {
         &mut self.runs
@@ -273,10 +281,10 @@ fn millions(speed: f64, runs: &[f64]) -> String {
 /// ratios with their range, since a slow spell of a noisy machine that falls on both runs
 /// of a round cancels in their ratio, and the range shows how far a target holds; otherwise
 /// the ratio of the two (median) runs.
-fn ratio(a: (f64, &[f64]), b: (f64, &[f64]), digits: usize, suffix: &str) -> String {
-    let (a_runs, b_runs) = (a.1, b.1);
+fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> String {
+    let (a_runs, b_runs) = (a.runs(), b.runs());
     if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
-        return format!("{:.digits$}{suffix}", a.0 / b.0);
+        return format!("{:.digits$}{suffix}", a.speed() / b.speed());
     }
     let mut rounds: Vec<f64> = a_runs.iter().zip(b_runs).map(|(a, b)| a / b).collect();
     rounds.sort_by(f64::total_cmp);
@@ -312,20 +320,13 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     for r in results {
         let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
         let one = results.iter().find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
-        fn speed_of(r: &BenchResult) -> (f64, &[f64]) {
-            (r.particle_steps_per_second, &r.runs)
-        }
-        let ours = speed_of(r);
         let cost = match edac {
             Some(e) if std::ptr::eq(e, r) => "1.00".to_string(),
-            Some(e) => ratio(speed_of(e), ours, 2, ""),
+            Some(e) => ratio(e, r, 2, ""),
             None => String::new(),
         };
-        let speedup = if r.threads > 1 {
-            one.map(|o| ratio(ours, speed_of(o), 2, "")).unwrap_or_default()
-        } else {
-            String::new()
-        };
+        let speedup =
+            if r.threads > 1 { one.map(|o| ratio(r, o, 2, "")).unwrap_or_default() } else { String::new() };
         let p = &r.phase_shares;
         let shares = format!(
             "{:.0}/{:.0}/{:.0}/{:.0}/{:.0}/{:.0}",
@@ -369,10 +370,8 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
                     let at_50 = peers
                         .iter()
                         .find(|q| q.nx == FIGURE_TO_BEAT_NX && q.threads == r.threads)
-                        .map_or(String::new(), |q| {
-                            ratio(ours, (q.particle_steps_per_second, &q.runs), 1, "x")
-                        });
-                    let to_peer = ratio(ours, (p.particle_steps_per_second, &p.runs), 1, "x");
+                        .map_or(String::new(), |q| ratio(r, q, 1, "x"));
+                    let to_peer = ratio(r, p, 1, "x");
                     s.insert_str(
                         s.len() - 1,
                         &format!(
@@ -499,7 +498,10 @@ mod peer_tests {
         // 3/1, 1/0.25, 2/1
         assert!(t.lines().nth(3).unwrap().contains("| 3.00 (2.00-4.00) |"), "{t}");
         // Of an even count of rounds, the mean of the two middle ratios.
-        assert_eq!(ratio((2.0, &[2.0, 4.0]), (1.0, &[1.0, 1.0]), 1, "x"), "3.0x (2.0-4.0)");
+        let (a, b) = (sample("edac", 100, 2, 2.0), sample("edac", 100, 1, 1.0));
+        let a = BenchResult { runs: vec![2.0, 4.0], ..a };
+        let b = BenchResult { runs: vec![1.0, 1.0], ..b };
+        assert_eq!(ratio(&a, &b, 1, "x"), "3.0x (2.0-4.0)");
     }
 
     #[test]
