@@ -23,13 +23,11 @@ fn image_code<const D: usize>(wraps: [i8; D]) -> u32 {
     wraps.iter().rev().fold(0, |code, &w| code * 3 + (w + 1) as u32)
 }
 
-/// Where [`NeighbourList::write_pairs`] writes one point's pairs: the differences `x_ij`,
-/// `|x_ij|^2` and a value per neighbour.
+/// Where [`NeighbourList::write_pairs`] writes one point's pairs: the differences `x_ij`
+/// and a value per neighbour.
 pub struct PairSlices<'a, const D: usize> {
     /// `x_i - x_j`, through the periodic image the pair was found through.
     pub xij: &'a mut [Vector<D>],
-    /// `|x_ij|^2`.
-    pub r2: &'a mut [f64],
     /// The neighbours' values.
     pub value: &'a mut [f64],
 }
@@ -63,11 +61,31 @@ impl HalfPairs {
         self.entries(i).len()
     }
 
+    /// Where point `i`'s pairs `j > i` sit among all the pairs of the run (in the order of
+    /// [`neighbours`](Self::neighbours) and [`gather`](Self::gather)).
+    #[inline(always)]
+    pub fn span(&self, i: usize) -> std::ops::Range<usize> {
+        let l = i - self.first;
+        self.start[l] as usize..self.start[l + 1] as usize
+    }
+
+    /// The neighbours `j` of the pairs of `span`.
+    #[inline(always)]
+    pub fn neighbours(&self, span: std::ops::Range<usize>) -> impl Iterator<Item = u32> + '_ {
+        self.entries[span].iter().map(|&e| e & J_MASK)
+    }
+
+    /// `values[j]` of every pair of the run, in its order, into `out`: values that stay
+    /// fixed while the pairs are swept several times, gathered once.
+    pub fn gather(&self, values: &[f64], out: &mut Vec<f64>) {
+        out.clear();
+        out.extend(self.entries.iter().map(|&e| values[(e & J_MASK) as usize]));
+    }
+
     /// The packed entries of point `i`'s pairs `j > i`.
     #[inline(always)]
     fn entries(&self, i: usize) -> &[u32] {
-        let l = i - self.first;
-        &self.entries[self.start[l] as usize..self.start[l + 1] as usize]
+        &self.entries[self.span(i)]
     }
 }
 
@@ -349,32 +367,32 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         out: PairSlices<D>,
     ) {
         let (chunk, range) = self.range(i);
-        self.write_entries(&chunk.entries[range], xi, points, values, out, |_, _| {});
-    }
-
-    /// Writes the pairs of `entries` from a query at `xi` into `out` (as
-    /// [`write_pairs`](Self::write_pairs) describes), calling `record(k, j)` with each
-    /// pair's slot and neighbour; returns how many.
-    #[inline(always)]
-    fn write_entries(
-        &self,
-        entries: &[u32],
-        xi: Vector<D>,
-        points: &[Vector<D>],
-        values: &[f64],
-        out: PairSlices<D>,
-        mut record: impl FnMut(usize, usize),
-    ) -> usize {
+        let entries = &chunk.entries[range];
         let n = entries.len();
-        let PairSlices { xij, r2, value } = out;
-        for (k, (((&e, xij), r2), value)) in
-            entries.iter().zip(&mut xij[..n]).zip(&mut r2[..n]).zip(&mut value[..n]).enumerate()
-        {
+        for ((&e, xij), value) in entries.iter().zip(&mut out.xij[..n]).zip(&mut out.value[..n]) {
             let j;
             (j, *xij) = self.pair(e, xi, points);
-            *r2 = xij.norm_squared();
             *value = values[j];
-            record(k, j);
+        }
+    }
+
+    /// As [`write_pairs`](Self::write_pairs) over the pairs `j > i` of point `i` listed in
+    /// `half` (by [`half_pairs`](Self::half_pairs)), the differences `x_ij` only (the
+    /// neighbours are [`HalfPairs::neighbours`], their values [`HalfPairs::gather`]).
+    /// Returns how many were written.
+    #[inline(always)]
+    pub fn write_half_pairs(
+        &self,
+        half: &HalfPairs,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        xij: &mut [Vector<D>],
+    ) -> usize {
+        let entries = half.entries(i);
+        let n = entries.len();
+        for (&e, xij) in entries.iter().zip(&mut xij[..n]) {
+            *xij = self.pair(e, xi, points).1;
         }
         n
     }
@@ -395,25 +413,6 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         // Room for a quarter more, as the list keeps, so that later steps do not allocate.
         let want = half.entries.len() + half.entries.len() / 4 + 256;
         half.entries.reserve(want.saturating_sub(half.entries.len()));
-    }
-
-    /// As [`write_pairs`](Self::write_pairs) over the pairs `j > i` of point `i` listed in
-    /// `half` (by [`half_pairs`](Self::half_pairs)), with the neighbours' indices in
-    /// `index`. Returns how many were written.
-    #[inline(always)]
-    #[allow(clippy::too_many_arguments)]
-    pub fn write_half_pairs(
-        &self,
-        half: &HalfPairs,
-        i: usize,
-        xi: Vector<D>,
-        points: &[Vector<D>],
-        values: &[f64],
-        out: PairSlices<D>,
-        index: &mut [u32],
-    ) -> usize {
-        let index = &mut index[..half.count(i)];
-        self.write_entries(half.entries(i), xi, points, values, out, |k, j| index[k] = j as u32)
     }
 
     /// Total number of (ordered) pairs.
@@ -473,12 +472,12 @@ mod tests {
                 let values: Vec<f64> = (0..pts.len()).map(|j| j as f64).collect();
                 let n = nl.count(i);
                 assert_eq!(n, brute[i].len());
-                let (mut xij, mut r2, mut value) = (vec![Vector::zeros(); n], vec![0.0; n], vec![0.0; n]);
-                let out = PairSlices { xij: &mut xij, r2: &mut r2, value: &mut value };
+                let (mut xij, mut value) = (vec![Vector::zeros(); n], vec![0.0; n]);
+                let out = PairSlices { xij: &mut xij, value: &mut value };
                 nl.write_pairs(i, moved[i], &moved, &values, out);
                 let mut k = 0;
-                nl.for_each(i, &moved, |j, x, d2, _| {
-                    assert_eq!((xij[k], r2[k], value[k]), (x, d2, j as f64));
+                nl.for_each(i, &moved, |j, x, _, _| {
+                    assert_eq!((xij[k], value[k]), (x, j as f64));
                     k += 1;
                 });
             }
@@ -490,21 +489,29 @@ mod tests {
             nl.half_pairs(0..split, &mut first);
             nl.half_pairs(split..pts.len(), &mut second);
             let values: Vec<f64> = (0..pts.len()).map(|j| 2.0 * j as f64).collect();
+            let (mut first_values, mut second_values) = (Vec::new(), Vec::new());
+            first.gather(&values, &mut first_values);
+            second.gather(&values, &mut second_values);
             for i in 0..pts.len() {
-                let half = if i < split { &first } else { &second };
-                let n = nl.count(i);
-                let (mut xij, mut r2, mut value, mut index) =
-                    (vec![Vector::zeros(); n], vec![0.0; n], vec![0.0; n], vec![0u32; n]);
-                let out = PairSlices { xij: &mut xij, r2: &mut r2, value: &mut value };
-                let m = nl.write_half_pairs(half, i, pts[i], &pts, &values, out, &mut index);
+                let (half, half_values) =
+                    if i < split { (&first, &first_values) } else { (&second, &second_values) };
+                let mut xij = vec![Vector::zeros(); nl.count(i)];
+                let m = nl.write_half_pairs(half, i, pts[i], &pts, &mut xij);
                 assert_eq!(m, half.count(i));
+                let span = half.span(i);
+                assert_eq!(span.len(), m);
                 let mut expected = Vec::new();
-                nl.for_each(i, &pts, |j, x, d2, _| {
+                nl.for_each(i, &pts, |j, x, _, _| {
                     if j > i {
-                        expected.push((j as u32, x, d2, 2.0 * j as f64));
+                        expected.push((j as u32, x, 2.0 * j as f64));
                     }
                 });
-                let got: Vec<_> = (0..m).map(|k| (index[k], xij[k], r2[k], value[k])).collect();
+                let got: Vec<_> = half
+                    .neighbours(span.clone())
+                    .zip(&xij[..m])
+                    .zip(&half_values[span])
+                    .map(|((j, &x), &v)| (j, x, v))
+                    .collect();
                 assert_eq!(got, expected, "point {i}");
             }
         }

@@ -376,11 +376,11 @@ impl<const D: usize> FluidPasses<D> {
         self.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
         self.ipst_slabs.resize_with(self.slabs.len(), IpstSlab::default);
         self.slab_chi_max.resize(self.slabs.len(), f64::MIN);
-        let slabs = &self.slabs;
-        self.ipst_slabs
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(t, slab)| nl.half_pairs(slabs.range(t), &mut slab.half));
+        let (slabs, vol) = (&self.slabs, &self.vol);
+        self.ipst_slabs.par_iter_mut().enumerate().for_each(|(t, slab)| {
+            nl.half_pairs(slabs.range(t), &mut slab.half);
+            slab.half.gather(vol, &mut slab.vol);
+        });
         // A particle's own share of chi (its pair with itself is not in the half list).
         let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
         let (vol, wall_vol, slabs) = (&self.vol, &self.wall_vol, &self.slabs);
@@ -455,8 +455,10 @@ const LANES: usize = 8;
 /// its pairs that belong to particles of other slabs, `(j, V_a W_ab x_ba / r, h^2 W_ab)`.
 #[derive(Clone, Debug, Default)]
 struct IpstSlab<const D: usize> {
-    /// The slab's fluid pairs `j > i`, listed once a step.
+    /// The slab's fluid pairs `j > i`, listed once a step,
     half: HalfPairs,
+    /// and their neighbours' volumes `V_j`, which the moves do not change.
+    vol: Vec<f64>,
     pairs: IpstPairs<D>,
     spill: Vec<(u32, Vector<D>, f64)>,
 }
@@ -483,16 +485,17 @@ impl<const D: usize> IpstSlab<D> {
         for group in particles.step_by(IPST_GROUP) {
             let group = group..(group + IPST_GROUP).min(first + sums.len());
             let p = &mut self.pairs;
-            p.evaluate(group.clone(), xs, nl, &self.half, vol, walls, k);
+            p.evaluate(group.clone(), xs, nl, &self.half, walls, k);
             for (l, i) in group.enumerate() {
                 let (fluid, wall) = p.ranges(l);
                 let v_i = vol[i];
                 let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
                 let (pair_x, pair_f, pair_w) =
                     (&p.xij[fluid.clone()], &p.factor[fluid.clone()], &p.w[fluid.clone()]);
-                let (pair_v, pair_j) = (&p.vol[fluid.clone()], &p.index[fluid]);
+                let span = self.half.span(i);
+                let (pair_v, pair_j) = (&self.vol[span.clone()], self.half.neighbours(span));
                 let pairs = pair_x.iter().zip(pair_f).zip(pair_w).zip(pair_v.iter().zip(pair_j));
-                for (((&xij, &f), &w), (&v_j, &j)) in pairs {
+                for (((&xij, &f), &w), (&v_j, j)) in pairs {
                     d += xij * (f * v_j);
                     chi += w;
                     // x_ji = -x_ij
@@ -522,19 +525,19 @@ impl<const D: usize> IpstSlab<D> {
 
 /// The pairs of a group of particles at moved positions, as arrays (reused from group to
 /// group), for the IPST sums of eqs. (37) and (40): for each particle its fluid pairs
-/// `j > i`, then its wall pairs. The kernel and the factors are evaluated for all the pairs
-/// at once in vectorised loops.
+/// `j > i`, then its wall pairs. The distances, the kernel and the factors are evaluated
+/// for all the pairs at once in vectorised loops.
 #[derive(Clone, Debug, Default)]
 struct IpstPairs<const D: usize> {
     /// Where each particle's fluid pairs end, and where its wall pairs end.
     fluid_end: Vec<usize>,
     end: Vec<usize>,
     xij: Vec<Vector<D>>,
-    /// |x_ij|^2, then |x_ij|.
+    /// |x_ij|.
     r: Vec<f64>,
-    /// The neighbours' volumes and (fluid) indices.
+    /// The wall neighbours' volumes (at the wall pairs' slots; the fluid neighbours' are
+    /// the slab's).
     vol: Vec<f64>,
-    index: Vec<u32>,
     /// W_ab, then h^2 W_ab (eq. 40).
     w: Vec<f64>,
     /// W_ab / r_ab (eq. 37).
@@ -542,16 +545,14 @@ struct IpstPairs<const D: usize> {
 }
 
 impl<const D: usize> IpstPairs<D> {
-    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (volumes `vol`,
-    /// the pairs `j > i` only) and the walls (with theirs).
-    #[allow(clippy::too_many_arguments)]
+    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (the pairs
+    /// `j > i` only) and the walls (with their volumes).
     fn evaluate(
         &mut self,
         particles: std::ops::Range<usize>,
         xs: &[Vector<D>],
         nl: &KernelList<D>,
         half: &HalfPairs,
-        vol: &[f64],
         walls: Option<(&WallSet<D>, &[f64])>,
         k: &ScaledKernel,
     ) {
@@ -565,7 +566,6 @@ impl<const D: usize> IpstPairs<D> {
             // not allocate.
             let grown = (room + room / 4).next_multiple_of(LANES);
             self.xij.resize(grown, Vector::zeros());
-            self.index.resize(grown, 0);
             for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.factor] {
                 a.resize(grown, 0.0);
             }
@@ -574,24 +574,18 @@ impl<const D: usize> IpstPairs<D> {
         self.end.clear();
         let mut at = 0;
         for i in particles {
-            let out =
-                PairSlices { xij: &mut self.xij[at..], r2: &mut self.r[at..], value: &mut self.vol[at..] };
-            at += nl.write_half_pairs(half, i, xs[i], xs, vol, out, &mut self.index[at..]);
+            at += nl.write_half_pairs(half, i, xs[i], xs, &mut self.xij[at..]);
             self.fluid_end.push(at);
             if let Some((ws, wall_vol)) = walls {
-                let out = PairSlices {
-                    xij: &mut self.xij[at..],
-                    r2: &mut self.r[at..],
-                    value: &mut self.vol[at..],
-                };
+                let out = PairSlices { xij: &mut self.xij[at..], value: &mut self.vol[at..] };
                 ws.fluid_to_wall.write_pairs(i, xs[i], &ws.wall.x, wall_vol, out);
                 at += ws.fluid_to_wall.count(i);
             }
             self.end.push(at);
         }
         let r = &mut self.r[..room];
-        for r in r.iter_mut() {
-            *r = r.sqrt();
+        for (r, xij) in r.iter_mut().zip(&self.xij[..room]) {
+            *r = xij.norm_squared().sqrt();
         }
         k.w_batch_at_distances(r, &mut self.w[..room]);
         // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
