@@ -239,12 +239,21 @@ impl ScaledKernel {
         })
     }
 
-    /// [`w`](Self::w) at the distances `r[k]` into `out[k]` (for callers that need `r`
-    /// themselves and take the square root once).
-    pub fn w_batch_at_distances(&self, r: &[f64], out: &mut [f64]) {
+    /// `out[k] = f(r, W(r))` at the distance `r = distance(&items[k])` of each item: one
+    /// loop the compiler vectorises for callers that need more of a pair than W (the
+    /// kernel's match is outside it).
+    #[inline(always)]
+    pub fn map_batch<X, Y>(
+        &self,
+        items: &[X],
+        out: &mut [Y],
+        distance: impl Fn(&X) -> f64,
+        f: impl Fn(f64, f64) -> Y,
+    ) {
         with_shape!(self.kernel.kind, shape => {
-            for (o, &r) in out.iter_mut().zip(r) {
-                *o = self.fac * shape(r * self.inv_h).0;
+            for (o, x) in out.iter_mut().zip(items) {
+                let r = distance(x);
+                *o = f(r, self.fac * shape(r * self.inv_h).0);
             }
         })
     }
@@ -358,15 +367,14 @@ mod tests {
             let r2: Vec<f64> = (0..1000).map(|i| (i as f64 * 1.1e-4).powi(2)).collect();
             let mut both = vec![(0.0, 0.0); r2.len()];
             let mut w = vec![0.0; r2.len()];
-            let mut w_at_r = vec![0.0; r2.len()];
+            let mut mapped = vec![(0.0, 0.0); r2.len()];
             k.w_and_grad_factor_batch(&r2, &mut both);
             k.w_batch(&r2, &mut w);
-            let r: Vec<f64> = r2.iter().map(|r2| r2.sqrt()).collect();
-            k.w_batch_at_distances(&r, &mut w_at_r);
+            k.map_batch(&r2, &mut mapped, |r2| r2.sqrt(), |r, w| (r, w));
             for (i, &r2) in r2.iter().enumerate() {
                 assert_eq!(both[i], k.w_and_grad_factor(r2.sqrt()), "{kind:?} at r2 = {r2}");
                 assert_eq!(w[i], k.w(r2.sqrt()));
-                assert_eq!(w_at_r[i], w[i]);
+                assert_eq!(mapped[i], (r2.sqrt(), w[i]));
             }
         }
     }

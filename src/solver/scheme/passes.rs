@@ -490,12 +490,11 @@ impl<const D: usize> IpstSlab<D> {
                 let (fluid, wall) = p.ranges(l);
                 let v_i = vol[i];
                 let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
-                let (pair_x, pair_f, pair_w) =
-                    (&p.xij[fluid.clone()], &p.factor[fluid.clone()], &p.w[fluid.clone()]);
+                let (pair_x, pair_fw) = (&p.xij[fluid.clone()], &p.fw[fluid]);
                 let span = self.half.span(i);
                 let (pair_v, pair_j) = (&self.vol[span.clone()], self.half.neighbours(span));
-                let pairs = pair_x.iter().zip(pair_f).zip(pair_w).zip(pair_v.iter().zip(pair_j));
-                for (((&xij, &f), &w), (&v_j, j)) in pairs {
+                let pairs = pair_x.iter().zip(pair_fw).zip(pair_v.iter().zip(pair_j));
+                for ((&xij, &(f, w)), (&v_j, j)) in pairs {
                     d += xij * (f * v_j);
                     chi += w;
                     // x_ji = -x_ij
@@ -509,8 +508,9 @@ impl<const D: usize> IpstSlab<D> {
                     }
                 }
                 for q in wall {
-                    d += p.xij[q] * (p.factor[q] * p.vol[q]);
-                    chi += p.w[q];
+                    let (f, w) = p.fw[q];
+                    d += p.xij[q] * (f * p.vol[q]);
+                    chi += w;
                 }
                 let sum = &mut sums[i - first];
                 sum.0 += d;
@@ -533,15 +533,11 @@ struct IpstPairs<const D: usize> {
     fluid_end: Vec<usize>,
     end: Vec<usize>,
     xij: Vec<Vector<D>>,
-    /// |x_ij|.
-    r: Vec<f64>,
     /// The wall neighbours' volumes (at the wall pairs' slots; the fluid neighbours' are
     /// the slab's).
     vol: Vec<f64>,
-    /// W_ab, then h^2 W_ab (eq. 40).
-    w: Vec<f64>,
-    /// W_ab / r_ab (eq. 37).
-    factor: Vec<f64>,
+    /// `W_ab / r_ab` (eq. 37) and `h^2 W_ab` (eq. 40).
+    fw: Vec<(f64, f64)>,
 }
 
 impl<const D: usize> IpstPairs<D> {
@@ -561,14 +557,13 @@ impl<const D: usize> IpstPairs<D> {
         // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
         // padding holds earlier (finite) values, which no sum reads.
         let room = n.next_multiple_of(LANES);
-        if self.r.len() < room {
+        if self.xij.len() < room {
             // A quarter more than needed, so that groups with a few more pairs later on do
             // not allocate.
             let grown = (room + room / 4).next_multiple_of(LANES);
             self.xij.resize(grown, Vector::zeros());
-            for a in [&mut self.r, &mut self.vol, &mut self.w, &mut self.factor] {
-                a.resize(grown, 0.0);
-            }
+            self.vol.resize(grown, 0.0);
+            self.fw.resize(grown, (0.0, 0.0));
         }
         self.fluid_end.clear();
         self.end.clear();
@@ -583,16 +578,12 @@ impl<const D: usize> IpstPairs<D> {
             }
             self.end.push(at);
         }
-        let r = &mut self.r[..room];
-        for (r, xij) in r.iter_mut().zip(&self.xij[..room]) {
-            *r = xij.norm_squared().sqrt();
-        }
-        k.w_batch_at_distances(r, &mut self.w[..room]);
-        // One vectorised loop for the per-pair factors (`w` then holds the chi shares).
-        for ((f, w), &r) in self.factor[..room].iter_mut().zip(&mut self.w[..room]).zip(&*r) {
-            *f = shifting::ipst_factor(*w, r);
-            *w = shifting::ipst_chi(k.h, *w);
-        }
+        k.map_batch(
+            &self.xij[..room],
+            &mut self.fw[..room],
+            |xij| xij.norm_squared().sqrt(),
+            |r, w| (shifting::ipst_factor(w, r), shifting::ipst_chi(k.h, w)),
+        );
     }
 
     /// The fluid pairs and the wall pairs of the `l`-th particle of the group last
