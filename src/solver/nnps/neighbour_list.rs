@@ -79,6 +79,8 @@ impl HalfPairs {
     /// fixed while the pairs are swept several times, gathered once.
     pub fn gather(&self, values: &[f64], out: &mut Vec<f64>) {
         out.clear();
+        // The room the list keeps, so that `out` grows only when the list does.
+        out.reserve(self.entries.capacity());
         out.extend(self.entries.iter().map(|&e| values[(e & J_MASK) as usize]));
     }
 
