@@ -232,11 +232,7 @@ impl ScaledKernel {
     /// [`w`](Self::w) at `sqrt(r2[k])` into `out[k]`, as
     /// [`w_and_grad_factor_batch`](Self::w_and_grad_factor_batch).
     pub fn w_batch(&self, r2: &[f64], out: &mut [f64]) {
-        with_shape!(self.kernel.kind, shape => {
-            for (o, &r2) in out.iter_mut().zip(r2) {
-                *o = self.fac * shape(r2.sqrt() * self.inv_h).0;
-            }
-        })
+        self.map_batch(r2, out, |r2| r2.sqrt(), |_, w| w);
     }
 
     /// `out[k] = f(r, W(r))` at the distance `r = distance(&items[k])` of each item: one

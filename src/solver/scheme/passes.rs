@@ -376,14 +376,13 @@ impl<const D: usize> FluidPasses<D> {
         self.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
         self.ipst_slabs.resize_with(self.slabs.len(), IpstSlab::default);
         self.slab_chi_max.resize(self.slabs.len(), f64::MIN);
-        let (slabs, vol) = (&self.slabs, &self.vol);
+        let (vol, wall_vol, slabs) = (&self.vol, &self.wall_vol, &self.slabs);
         self.ipst_slabs.par_iter_mut().enumerate().for_each(|(t, slab)| {
             nl.half_pairs(slabs.range(t), &mut slab.half);
             slab.half.gather(vol, &mut slab.vol);
         });
         // A particle's own share of chi (its pair with itself is not in the half list).
         let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
-        let (vol, wall_vol, slabs) = (&self.vol, &self.wall_vol, &self.slabs);
         let walls = walls.map(|ws| (ws, &wall_vol[..]));
         let mut iterations = 0;
         while iterations < max_iter {
