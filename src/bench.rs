@@ -4,6 +4,7 @@
 //! peak resident memory is its own.
 
 use crate::scenes::taylor_green;
+use crate::solver::simulation::{PhaseTimes, Simulation};
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 
@@ -200,23 +201,17 @@ fn status_kb(field: &str) -> u64 {
         .unwrap_or(0)
 }
 
-/// Runs one configuration in this process: `warmup` untimed steps, then `steps` timed
-/// ones, from a lattice perturbed by 5 % of dx. IPST is timed at its iteration cap (10
-/// moves a step, with a tolerance it never meets): a developed Taylor-Green flow sits there
-/// (measured at nx = 50 and 100: from t = 0.09 on, every step makes the 10 moves), while
-/// the first steps of a run barely iterate, so timing those would understate its cost.
-pub fn run_case(
-    variant: &str,
-    nx: usize,
-    steps: u64,
-    warmup: u64,
-    kernel: &str,
-) -> Result<BenchResult, String> {
+/// The simulation a bench case times: Taylor-Green of `variant` at `nx` with `kernel`
+/// (Re = 100, h/dx = 1), from a lattice perturbed by 5 % of dx. IPST is timed at its
+/// iteration cap (10 moves a step, with a tolerance it never meets): a developed
+/// Taylor-Green flow sits there (measured at nx = 50 and 100: from t = 0.09 on, every step
+/// makes the 10 moves), while the first steps of a run barely iterate, so timing those would
+/// understate its cost.
+fn case_simulation(variant: &str, nx: usize, kernel: &str) -> Result<Simulation<2>, String> {
     let (_, scheme, pst) = VARIANTS
         .iter()
         .find(|v| v.0 == variant)
         .ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
-    let rss0 = status_kb("VmRSS:") * 1024;
     let p = taylor_green::params_from(&[
         &format!("nx={nx}"),
         &format!("scheme={scheme}"),
@@ -226,35 +221,152 @@ pub fn run_case(
         "perturb=0.05",
         "ipst_tol=1e-12",
     ])?;
-    let mut sim = taylor_green::simulation::<2>(&p)?;
+    taylor_green::simulation::<2>(&p)
+}
+
+/// What a configuration's timed steps added up to.
+#[derive(Default)]
+struct Timed {
+    seconds: f64,
+    steps: u64,
+    ipst: usize,
+    times: PhaseTimes,
+    /// Particle-steps per second of each block (`run_interleaved`).
+    runs: Vec<f64>,
+}
+
+impl Timed {
+    /// Times `steps` steps of `sim`, adding them up.
+    fn steps(&mut self, sim: &mut Simulation<2>, steps: u64) -> Result<(), String> {
+        sim.times = Default::default();
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+            self.ipst += sim.last_ipst_iterations();
+        }
+        let seconds = t0.elapsed().as_secs_f64();
+        self.seconds += seconds;
+        self.steps += steps;
+        self.times += sim.times;
+        self.runs.push(sim.fluid().len() as f64 * steps as f64 / seconds);
+        Ok(())
+    }
+
+    fn result(self, variant: &str, kernel: &str, nx: usize, threads: usize, particles: usize) -> BenchResult {
+        BenchResult {
+            variant: variant.into(),
+            kernel: kernel.into(),
+            nx,
+            threads,
+            particles,
+            steps: self.steps,
+            seconds: self.seconds,
+            particle_steps_per_second: particles as f64 * self.steps as f64 / self.seconds,
+            peak_rss_bytes: 0,
+            bytes_per_particle: 0.0,
+            ipst_iterations_mean: self.ipst as f64 / self.steps as f64,
+            phase_shares: self.times.scaled(1.0 / self.seconds),
+            runs: self.runs,
+        }
+    }
+}
+
+/// Runs one configuration in this process: `warmup` untimed steps of
+/// [`case_simulation`], then `steps` timed ones.
+pub fn run_case(
+    variant: &str,
+    nx: usize,
+    steps: u64,
+    warmup: u64,
+    kernel: &str,
+) -> Result<BenchResult, String> {
+    let rss0 = status_kb("VmRSS:") * 1024;
+    let mut sim = case_simulation(variant, nx, kernel)?;
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
-    sim.times = Default::default();
-    let t0 = Instant::now();
-    let mut ipst = 0usize;
-    for _ in 0..steps {
-        sim.step(f64::INFINITY).map_err(|d| d.reason)?;
-        ipst += sim.last_ipst_iterations();
-    }
-    let seconds = t0.elapsed().as_secs_f64();
+    let mut timed = Timed::default();
+    timed.steps(&mut sim, steps)?;
+    timed.runs.clear();
     let n = sim.fluid().len();
     let hwm = status_kb("VmHWM:") * 1024;
     Ok(BenchResult {
-        variant: variant.into(),
-        kernel: kernel.into(),
-        nx,
-        threads: rayon::current_num_threads(),
-        particles: n,
-        steps,
-        seconds,
-        particle_steps_per_second: n as f64 * steps as f64 / seconds,
         peak_rss_bytes: hwm,
         bytes_per_particle: hwm.saturating_sub(rss0) as f64 / n as f64,
-        ipst_iterations_mean: ipst as f64 / steps as f64,
-        phase_shares: sim.times.scaled(1.0 / seconds),
-        runs: Vec::new(),
+        ..timed.result(variant, kernel, nx, rayon::current_num_threads(), n)
     })
+}
+
+/// Times every variant of `variants` on every thread count of `threads` at `nx` side by
+/// side in this process (`bench --interleave`): their simulations are built and warmed up
+/// (`warmup` steps) together, then stepped in turn, `rounds` times, a block of
+/// `steps / rounds` timed steps each (after one untimed step, since the caches then hold
+/// the configuration before), each thread count on its own pool; the order of a round is
+/// reversed every other round. A slow spell of a noisy machine, even one of seconds, then
+/// falls on every configuration alike, and each block's throughput is a run (`runs`), so
+/// that every ratio is the median of the rounds' own ratios. A variant's thread counts step
+/// the same simulation, whose results do not depend on the thread count. Memory: the
+/// resident growth while a simulation was built and warmed (`bytes_per_particle`), and the
+/// process's peak with all of them (`peak_rss_bytes`).
+pub fn run_interleaved(
+    variants: &[String],
+    nx: usize,
+    threads: &[usize],
+    steps: u64,
+    rounds: u32,
+    warmup: u64,
+    kernel: &str,
+) -> Result<Vec<BenchResult>, String> {
+    let pools = threads
+        .iter()
+        .map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build())
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| format!("cannot start a thread pool: {e}"))?;
+    let widest = pools.iter().max_by_key(|p| p.current_num_threads()).ok_or("no thread count")?;
+    let mut sims = Vec::new();
+    for v in variants {
+        let rss0 = status_kb("VmRSS:") * 1024;
+        let sim = widest.install(|| -> Result<_, String> {
+            let mut sim = case_simulation(v, nx, kernel)?;
+            for _ in 0..warmup {
+                sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+            }
+            Ok(sim)
+        })?;
+        sims.push((sim, (status_kb("VmRSS:") * 1024).saturating_sub(rss0)));
+    }
+    let block = steps.div_ceil(rounds as u64).max(1);
+    let configs: Vec<(usize, usize)> =
+        (0..sims.len()).flat_map(|v| (0..pools.len()).map(move |t| (v, t))).collect();
+    let mut timed: Vec<Timed> = configs.iter().map(|_| Timed::default()).collect();
+    for round in 0..rounds {
+        let mut order: Vec<usize> = (0..configs.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for c in order {
+            let (v, t) = configs[c];
+            let sim = &mut sims[v].0;
+            pools[t].install(|| -> Result<(), String> {
+                sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+                timed[c].steps(sim, block)
+            })?;
+        }
+    }
+    let hwm = status_kb("VmHWM:") * 1024;
+    Ok(configs
+        .iter()
+        .zip(timed)
+        .map(|(&(v, t), timed)| {
+            let (sim, grown) = &sims[v];
+            let n = sim.fluid().len();
+            BenchResult {
+                peak_rss_bytes: hwm,
+                bytes_per_particle: *grown as f64 / n as f64,
+                ..timed.result(&variants[v], kernel, nx, threads[t], n)
+            }
+        })
+        .collect())
 }
 
 /// Steps to time for `n` particles: about 4 million particle-steps, at least 20 steps.
@@ -277,10 +389,12 @@ fn millions(speed: f64, runs: &[f64]) -> String {
 }
 
 /// The ratio `a / b` of two throughputs, as `digits` decimals and a `suffix`: with as many
-/// runs of each (`bench --repeat`, one of each per round), the median of the rounds' own
-/// ratios with their range, since a slow spell of a noisy machine that falls on both runs
-/// of a round cancels in their ratio, and the range shows how far a target holds; otherwise
-/// the ratio of the two (median) runs.
+/// runs of each (`bench --repeat`, or the rounds of `--interleave`), the median of the
+/// rounds' own ratios with their range, since a slow spell of a noisy machine that falls on
+/// both runs of a round cancels in their ratio, and the range shows how far a target holds
+/// in single rounds; from six rounds on also the 95 % confidence interval of that median
+/// (in brackets, [`median_interval`]), which says whether a target holds in the median;
+/// otherwise the ratio of the two (median) runs.
 fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> String {
     let (a_runs, b_runs) = (a.runs(), b.runs());
     if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
@@ -292,7 +406,29 @@ fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> S
     // Of an even count, the mean of the two middle ratios (neither favoured).
     let n = rounds.len();
     let median = (rounds[(n - 1) / 2] + rounds[n / 2]) / 2.0;
-    format!("{median:.digits$}{suffix} ({lo:.digits$}-{hi:.digits$})")
+    let interval =
+        median_interval(&rounds).map_or(String::new(), |(l, h)| format!(" [{l:.digits$}-{h:.digits$}]"));
+    format!("{median:.digits$}{suffix}{interval} ({lo:.digits$}-{hi:.digits$})")
+}
+
+/// A 95 % confidence interval of the median of the `sorted` samples, free of any assumption
+/// on their distribution: the `k`-th smallest and the `k`-th largest, with `k` the largest
+/// count for which fewer than `k` of `n` samples fall below the median with a probability
+/// of at most 2.5 % (binomial, p = 1/2), so that the interval covers the median with at
+/// least 95 %. None below six samples, where even the extremes cover less.
+pub fn median_interval(sorted: &[f64]) -> Option<(f64, f64)> {
+    let n = sorted.len();
+    // P(X = i) for X ~ B(n, 1/2), in logarithms (n may be large).
+    let ln_p = |i: usize| -> f64 {
+        let ln_choose: f64 = (0..i).map(|j| ((n - j) as f64).ln() - ((j + 1) as f64).ln()).sum();
+        ln_choose - n as f64 * std::f64::consts::LN_2
+    };
+    let (mut k, mut below) = (0, 0.0);
+    while k < n / 2 && below + ln_p(k).exp() <= 0.025 {
+        below += ln_p(k).exp();
+        k += 1;
+    }
+    (k > 0).then(|| (sorted[k - 1], sorted[n - k]))
 }
 
 /// The benchmark table as Markdown (throughput of the median run, with the range over the
@@ -502,6 +638,48 @@ mod peer_tests {
         let a = BenchResult { runs: vec![2.0, 4.0], ..a };
         let b = BenchResult { runs: vec![1.0, 1.0], ..b };
         assert_eq!(ratio(&a, &b, 1, "x"), "3.0x (2.0-4.0)");
+    }
+
+    /// Side by side: one result per variant and thread count, in the order of the table,
+    /// with one run per round and the block's steps added up; IPST at its cap.
+    #[test]
+    fn interleaved_cases_report_one_run_a_round() {
+        let variants = ["edac".to_string(), "ctvf+ipst".to_string()];
+        let r = run_interleaved(&variants, 12, &[1, 2], 5, 2, 1, DEFAULT_KERNEL).unwrap();
+        let got: Vec<_> = r.iter().map(|r| (r.variant.as_str(), r.threads, r.steps, r.runs.len())).collect();
+        assert_eq!(
+            got,
+            [("edac", 1, 6, 2), ("edac", 2, 6, 2), ("ctvf+ipst", 1, 6, 2), ("ctvf+ipst", 2, 6, 2)]
+        );
+        for r in &r {
+            assert_eq!(r.particles, 144);
+            assert!(r.particle_steps_per_second > 0.0 && r.runs.iter().all(|&s| s > 0.0));
+            // Every block's particle-steps over its seconds: the runs' harmonic mean.
+            let hm = r.runs.len() as f64 / r.runs.iter().map(|s| 1.0 / s).sum::<f64>();
+            assert!((hm / r.particle_steps_per_second - 1.0).abs() < 1e-9, "{r:?}");
+        }
+        assert_eq!((r[0].ipst_iterations_mean, r[2].ipst_iterations_mean), (0.0, 10.0));
+        assert!(run_interleaved(&["sph".to_string()], 12, &[1], 2, 2, 0, DEFAULT_KERNEL).is_err());
+    }
+
+    /// The interval of the median from order statistics: the extremes at six samples
+    /// (coverage 1 - 2/64), the 14th from each end at forty (96 %), none below six.
+    #[test]
+    fn the_median_interval_is_the_binomial_order_statistics() {
+        let v = |n: usize| (1..=n).map(|i| i as f64).collect::<Vec<_>>();
+        assert_eq!(median_interval(&v(5)), None);
+        assert_eq!(median_interval(&v(6)), Some((1.0, 6.0)));
+        assert_eq!(median_interval(&v(9)), Some((2.0, 8.0)));
+        assert_eq!(median_interval(&v(15)), Some((4.0, 12.0)));
+        assert_eq!(median_interval(&v(40)), Some((14.0, 27.0)));
+        // Large counts do not overflow: the interval narrows to about sqrt(n) around n/2.
+        let (lo, hi) = median_interval(&v(2000)).unwrap();
+        assert!((955.0..=960.0).contains(&lo) && hi == 2001.0 - lo, "{lo} {hi}");
+        // In the table, from six rounds on.
+        let run = |speed: f64, runs: Vec<f64>| BenchResult { runs, ..sample("edac", 100, 1, speed) };
+        let a = run(6.0, vec![2.0, 3.0, 4.0, 5.0, 6.0, 7.0]);
+        let b = run(1.0, vec![1.0; 6]);
+        assert_eq!(ratio(&a, &b, 1, "x"), "4.5x [2.0-7.0] (2.0-7.0)");
     }
 
     #[test]

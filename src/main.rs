@@ -133,6 +133,13 @@ struct BenchArgs {
     /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
     #[arg(long, default_value = bench::DEFAULT_KERNEL)]
     kernel: String,
+    /// Time the cases of each resolution side by side in one process, stepped in turn in
+    /// ROUNDS rounds of a block of steps each (the first step of a block untimed), so that
+    /// a slow spell of the machine, even one of seconds, falls on every variant and thread
+    /// count alike: every ratio is then the median of the rounds' own ratios. Memory is
+    /// the resident growth while each simulation was built.
+    #[arg(long, value_name = "ROUNDS", conflicts_with_all = ["repeat", "peer"], value_parser = clap::value_parser!(u32).range(2..))]
+    interleave: Option<u32>,
 }
 
 #[derive(Subcommand)]
@@ -217,6 +224,23 @@ enum Command {
         nx: usize,
         #[arg(long)]
         steps: u64,
+        #[arg(long, default_value = bench::DEFAULT_KERNEL)]
+        kernel: String,
+    },
+    /// The cases of one resolution timed side by side in this process (used by
+    /// `bench --interleave`).
+    #[command(hide = true)]
+    BenchInterleaved {
+        #[arg(long, value_delimiter = ',')]
+        variants: Vec<String>,
+        #[arg(long)]
+        nx: usize,
+        #[arg(long = "bench-threads", value_delimiter = ',')]
+        bench_threads: Vec<usize>,
+        #[arg(long)]
+        steps: u64,
+        #[arg(long)]
+        rounds: u32,
         #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
     },
@@ -381,17 +405,11 @@ fn run(cli: Cli) -> ExitCode {
         }
         Command::Bench(args) => run_bench(args),
         Command::BenchCase { variant, nx, steps, kernel } => {
-            match bench::run_case(&variant, nx, steps, 5, &kernel) {
-                Ok(r) => {
-                    println!("{}", serde_json::to_string(&r).expect("serialises"));
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(1)
-                }
-            }
+            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel))
         }
+        Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => print_json(
+            bench::run_interleaved(&variants, nx, &bench_threads, steps, rounds, BENCH_WARMUP, &kernel),
+        ),
     }
 }
 
@@ -427,6 +445,35 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &s
         .ok_or_else(|| "summary.json: no `l1_velocity_final`".to_string())
 }
 
+/// Untimed steps before a bench case is timed.
+const BENCH_WARMUP: u64 = 5;
+
+/// A bench child's result as one JSON line on stdout, or its error on stderr (exit 1).
+fn print_json(r: Result<impl serde::Serialize, String>) -> ExitCode {
+    match r {
+        Ok(r) => {
+            println!("{}", serde_json::to_string(&r).expect("serialises"));
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// Runs the hidden bench subcommand `args` in a child process and reads its JSON result.
+fn bench_child<T: serde::de::DeserializeOwned>(exe: &std::path::Path, args: &[&str]) -> Result<T, String> {
+    let o = std::process::Command::new(exe)
+        .args(args)
+        .output()
+        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
+    if !o.status.success() {
+        return Err(format!("failed: {}", String::from_utf8_lossy(&o.stderr)));
+    }
+    serde_json::from_slice(&o.stdout).map_err(|e| format!("unreadable result: {e}"))
+}
+
 /// One benchmark configuration, timed in a process of its own (`bench-case`) so that each
 /// starts from the same memory state and its peak memory is its own.
 fn bench_case(
@@ -438,27 +485,57 @@ fn bench_case(
     kernel: &str,
 ) -> Result<bench::BenchResult, String> {
     let (nx, threads, steps) = (nx.to_string(), threads.to_string(), steps.to_string());
-    let args = [
-        "--threads",
-        &threads,
-        "bench-case",
-        "--variant",
-        variant,
-        "--nx",
-        &nx,
-        "--steps",
-        &steps,
-        "--kernel",
-        kernel,
-    ];
-    let o = std::process::Command::new(exe)
-        .args(args)
-        .output()
-        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
-    if !o.status.success() {
-        return Err(format!("failed: {}", String::from_utf8_lossy(&o.stderr)));
-    }
-    serde_json::from_slice(&o.stdout).map_err(|e| format!("unreadable result: {e}"))
+    bench_child(
+        exe,
+        &[
+            "--threads",
+            &threads,
+            "bench-case",
+            "--variant",
+            variant,
+            "--nx",
+            &nx,
+            "--steps",
+            &steps,
+            "--kernel",
+            kernel,
+        ],
+    )
+}
+
+/// The cases of resolution `nx` timed side by side in a process of their own
+/// (`bench-interleaved`; see `bench::run_interleaved`).
+fn bench_interleaved(
+    exe: &std::path::Path,
+    variants: &[String],
+    nx: usize,
+    threads: &[usize],
+    steps: u64,
+    rounds: u32,
+    kernel: &str,
+) -> Result<Vec<bench::BenchResult>, String> {
+    let list = |v: Vec<String>| v.join(",");
+    let (variants, threads) =
+        (list(variants.to_vec()), list(threads.iter().map(|t| t.to_string()).collect()));
+    let (nx, steps, rounds) = (nx.to_string(), steps.to_string(), rounds.to_string());
+    bench_child(
+        exe,
+        &[
+            "bench-interleaved",
+            "--variants",
+            &variants,
+            "--nx",
+            &nx,
+            "--bench-threads",
+            &threads,
+            "--steps",
+            &steps,
+            "--rounds",
+            &rounds,
+            "--kernel",
+            kernel,
+        ],
+    )
 }
 
 /// One run of a peer's script at `nx` on `threads` threads to time `tf`, read from the
@@ -481,7 +558,8 @@ fn peer_run(
 }
 
 fn run_bench(args: BenchArgs) -> ExitCode {
-    let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel } = args;
+    let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel, interleave } =
+        args;
     let kernel = kernel.as_str();
     if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
         eprintln!(
@@ -507,6 +585,39 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     // A case or a peer run that fails ends the sitting, but what was measured before it is
     // still reported and written.
     let mut failure: Option<String> = None;
+    if let Some(rounds) = interleave {
+        for &n in &nx {
+            let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
+            eprint!(
+                "bench nx={n}, {} on {threads:?} threads side by side, {rounds} rounds of {} steps each ... ",
+                variants.join(", "),
+                k.div_ceil(rounds as u64)
+            );
+            match bench_interleaved(&exe, &variants, n, &threads, k, rounds, kernel) {
+                Ok(r) => {
+                    let speeds: Vec<String> = r
+                        .iter()
+                        .map(|r| {
+                            format!(
+                                "{} on {}: {:.3} M",
+                                r.variant,
+                                r.threads,
+                                r.particle_steps_per_second / 1e6
+                            )
+                        })
+                        .collect();
+                    eprintln!("{}", speeds.join(", "));
+                    results.extend(r);
+                }
+                Err(e) => {
+                    eprintln!("{e}");
+                    failure = Some(format!("bench nx={n}, side by side: {e}"));
+                    break;
+                }
+            }
+        }
+    }
+    let repeat = if interleave.is_some() { 0 } else { repeat };
     'rounds: for round in 1..=repeat {
         let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
         for &n in &nx {
@@ -549,7 +660,8 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
         }
     }
-    let results = bench::median_runs(results);
+    // Side by side, each configuration is one result already, its blocks its runs.
+    let results = if interleave.is_some() { results } else { bench::median_runs(results) };
     let mut peers = bench::median_runs(peers);
     for p in &mut peers {
         let (n, t) = (p.nx, p.threads);

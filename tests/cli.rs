@@ -313,6 +313,60 @@ fn bench_repeats_every_case_and_reports_the_median_run() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("--repeat"));
 }
 
+/// `bench --interleave 3`: the cases of a size side by side in one process, each
+/// configuration once in the results with a run a round, so that the cost and the speed-up
+/// are medians of the rounds' ratios; it does not go with `--repeat` or `--peer`, and needs
+/// two rounds at least.
+#[test]
+fn bench_interleaves_the_cases_of_a_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("bench.json");
+    let bin = env!("CARGO_BIN_EXE_sphrepro");
+    let out = Command::new(bin)
+        .args([
+            "bench",
+            "--nx",
+            "16",
+            "--bench-threads",
+            "1,2",
+            "--variants",
+            "edac,ctvf+sun",
+            "--steps",
+            "6",
+        ])
+        .args(["--interleave", "3", "--json", json.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let rows: Vec<_> = v
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            (
+                r["variant"].as_str().unwrap(),
+                r["threads"].as_u64().unwrap(),
+                r["runs"].as_array().unwrap().len(),
+            )
+        })
+        .collect();
+    assert_eq!(rows, [("edac", 1, 3), ("edac", 2, 3), ("ctvf+sun", 1, 3), ("ctvf+sun", 2, 3)]);
+    let table = String::from_utf8_lossy(&out.stdout);
+    // The cost of ctvf+sun and the speed-up with their ranges over the rounds.
+    let sun = table.lines().find(|l| l.starts_with("| ctvf+sun | 16 | 256 | 2 |")).unwrap();
+    assert_eq!(sun.matches(") |").count(), 3, "{sun}");
+    for bad in [
+        &["--interleave", "3", "--repeat", "2"][..],
+        &["--interleave", "1"],
+        &["--interleave", "2", "--peer", "x"],
+    ] {
+        let out = Command::new(bin).arg("bench").args(bad).output().unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--interleave"), "{bad:?}");
+    }
+}
+
 /// SIGTERM and SIGHUP stop a run as Ctrl-C does (a checkpoint, a `failed` summary), but a
 /// SIGHUP ignored by whoever started it (`nohup`) stays ignored.
 #[cfg(unix)]

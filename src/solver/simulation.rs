@@ -95,6 +95,17 @@ pub struct PhaseTimes {
     pub ipst: f64,
 }
 
+impl std::ops::AddAssign for PhaseTimes {
+    fn add_assign(&mut self, o: Self) {
+        self.integrate += o.integrate;
+        self.neighbours += o.neighbours;
+        self.density += o.density;
+        self.pressure += o.pressure;
+        self.accelerations += o.accelerations;
+        self.ipst += o.ipst;
+    }
+}
+
 impl PhaseTimes {
     /// Every phase multiplied by `f` (e.g. 1 / total, for shares).
     pub fn scaled(&self, f: f64) -> Self {
