@@ -1,7 +1,9 @@
 //! `sphrepro bench`: throughput (particle-steps per second) and peak memory per particle
 //! of the Taylor-Green vortex for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, over resolutions
 //! and thread counts. Each configuration runs in its own process (`bench-case`), so its
-//! peak resident memory is its own.
+//! peak resident memory is its own; or, with `--interleave`, the configurations of a size
+//! run side by side in one process (`bench-interleaved`), stepped in turn, so that the
+//! machine's slow spells fall on all of them alike.
 
 use crate::scenes::taylor_green;
 use crate::solver::simulation::{PhaseTimes, Simulation};
@@ -207,7 +209,8 @@ fn status_kb(field: &str) -> u64 {
 /// Taylor-Green flow sits there (measured at nx = 50 and 100: from t = 0.09 on, every step
 /// makes the 10 moves), while the first steps of a run barely iterate, so timing those would
 /// understate its cost.
-fn case_simulation(variant: &str, nx: usize, kernel: &str) -> Result<Simulation<2>, String> {
+/// It is returned after `warmup` untimed steps.
+fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Result<Simulation<2>, String> {
     let (_, scheme, pst) = VARIANTS
         .iter()
         .find(|v| v.0 == variant)
@@ -221,7 +224,11 @@ fn case_simulation(variant: &str, nx: usize, kernel: &str) -> Result<Simulation<
         "perturb=0.05",
         "ipst_tol=1e-12",
     ])?;
-    taylor_green::simulation::<2>(&p)
+    let mut sim = taylor_green::simulation::<2>(&p)?;
+    for _ in 0..warmup {
+        sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+    }
+    Ok(sim)
 }
 
 /// What a configuration's timed steps added up to.
@@ -281,10 +288,7 @@ pub fn run_case(
     kernel: &str,
 ) -> Result<BenchResult, String> {
     let rss0 = status_kb("VmRSS:") * 1024;
-    let mut sim = case_simulation(variant, nx, kernel)?;
-    for _ in 0..warmup {
-        sim.step(f64::INFINITY).map_err(|d| d.reason)?;
-    }
+    let mut sim = case_simulation(variant, nx, kernel, warmup)?;
     let mut timed = Timed::default();
     timed.steps(&mut sim, steps)?;
     timed.runs.clear();
@@ -326,13 +330,7 @@ pub fn run_interleaved(
     let mut sims = Vec::new();
     for v in variants {
         let rss0 = status_kb("VmRSS:") * 1024;
-        let sim = widest.install(|| -> Result<_, String> {
-            let mut sim = case_simulation(v, nx, kernel)?;
-            for _ in 0..warmup {
-                sim.step(f64::INFINITY).map_err(|d| d.reason)?;
-            }
-            Ok(sim)
-        })?;
+        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
         sims.push((sim, (status_kb("VmRSS:") * 1024).saturating_sub(rss0)));
     }
     let block = steps.div_ceil(rounds as u64).max(1);
