@@ -238,7 +238,7 @@ struct Timed {
     steps: u64,
     ipst: usize,
     times: PhaseTimes,
-    /// Particle-steps per second of each block (`run_interleaved`).
+    /// Particle-steps per second of each block of steps.
     runs: Vec<f64>,
 }
 
@@ -291,7 +291,6 @@ pub fn run_case(
     let mut sim = case_simulation(variant, nx, kernel, warmup)?;
     let mut timed = Timed::default();
     timed.steps(&mut sim, steps)?;
-    timed.runs.clear();
     let n = sim.fluid().len();
     let hwm = status_kb("VmHWM:") * 1024;
     Ok(BenchResult {
@@ -416,14 +415,12 @@ fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> S
 /// least 95 %. None below six samples, where even the extremes cover less.
 pub fn median_interval(sorted: &[f64]) -> Option<(f64, f64)> {
     let n = sorted.len();
-    // P(X = i) for X ~ B(n, 1/2), in logarithms (n may be large).
-    let ln_p = |i: usize| -> f64 {
-        let ln_choose: f64 = (0..i).map(|j| ((n - j) as f64).ln() - ((j + 1) as f64).ln()).sum();
-        ln_choose - n as f64 * std::f64::consts::LN_2
-    };
+    // ln P(X = k) for X ~ B(n, 1/2), from k = 0 up (in logarithms: n may be large).
+    let mut ln_p = -(n as f64) * std::f64::consts::LN_2;
     let (mut k, mut below) = (0, 0.0);
-    while k < n / 2 && below + ln_p(k).exp() <= 0.025 {
-        below += ln_p(k).exp();
+    while k < n / 2 && below + ln_p.exp() <= 0.025 {
+        below += ln_p.exp();
+        ln_p += ((n - k) as f64).ln() - ((k + 1) as f64).ln();
         k += 1;
     }
     (k > 0).then(|| (sorted[k - 1], sorted[n - k]))

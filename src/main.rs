@@ -514,9 +514,8 @@ fn bench_interleaved(
     rounds: u32,
     kernel: &str,
 ) -> Result<Vec<bench::BenchResult>, String> {
-    let list = |v: Vec<String>| v.join(",");
-    let (variants, threads) =
-        (list(variants.to_vec()), list(threads.iter().map(|t| t.to_string()).collect()));
+    let variants = variants.join(",");
+    let threads = threads.iter().map(|t| t.to_string()).collect::<Vec<_>>().join(",");
     let (nx, steps, rounds) = (nx.to_string(), steps.to_string(), rounds.to_string());
     bench_child(
         exe,
@@ -617,6 +616,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
         }
     }
+    // Side by side, our cases ran above: no rounds of processes.
     let repeat = if interleave.is_some() { 0 } else { repeat };
     'rounds: for round in 1..=repeat {
         let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
