@@ -2,6 +2,7 @@
 
 use super::Domain;
 use crate::solver::math::Vector;
+use rayon::prelude::*;
 
 /// Points of one body binned into cells of edge >= the search radius.
 #[derive(Clone, Debug)]
@@ -95,17 +96,24 @@ impl<const D: usize> CellList<D> {
     /// coordinates must already be wrapped into the box.
     pub fn update(&mut self, points: &[Vector<D>]) {
         let n = points.len();
-        self.cell_of.resize(n, 0);
         self.sorted.resize(n, 0);
+        // The cells of the points in parallel (the divisions and roundings are most of the
+        // binning), then a serial count: the order depends on nothing but the points.
+        let mut cell_of = std::mem::take(&mut self.cell_of);
+        cell_of.resize(n, 0);
+        cell_of.par_iter_mut().zip(points).with_min_len(crate::solver::LIGHT_LOOP_LEN).for_each(
+            |(cell, x)| {
+                let mut c = [0usize; D];
+                for (k, ck) in c.iter_mut().enumerate() {
+                    *ck = self.coord(x[k], k);
+                }
+                *cell = self.linear(&c) as u32;
+            },
+        );
+        self.cell_of = cell_of;
         self.cell_start.iter_mut().for_each(|c| *c = 0);
-        for (i, x) in points.iter().enumerate() {
-            let mut c = [0usize; D];
-            for (k, ck) in c.iter_mut().enumerate() {
-                *ck = self.coord(x[k], k);
-            }
-            let cell = self.linear(&c);
-            self.cell_of[i] = cell as u32;
-            self.cell_start[cell + 1] += 1;
+        for &cell in &self.cell_of {
+            self.cell_start[cell as usize + 1] += 1;
         }
         for c in 0..self.cell_start.len() - 1 {
             self.cell_start[c + 1] += self.cell_start[c];
