@@ -91,8 +91,18 @@ impl HalfPairs {
     }
 }
 
+/// Lengthens `v` to at least `len` (never shortens it).
+fn grow<T: Copy + Default>(v: &mut Vec<T>, len: usize) {
+    if v.len() < len {
+        v.resize(len, T::default());
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 struct Chunk<const D: usize, P> {
+    /// Where each point's entries start, and after the last point where they end: the
+    /// entries and payload past that end are stale room, kept between builds so that
+    /// [`NeighbourList::build_reducing`] writes no zeros into it.
     start: Vec<u32>,
     entries: Vec<u32>,
     payload: Vec<P>,
@@ -112,6 +122,11 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
         self.entries.clear();
         self.payload.clear();
         self.r2.clear();
+    }
+
+    /// The number of pairs listed.
+    fn pairs(&self) -> usize {
+        self.start.last().map_or(0, |&end| end as usize)
     }
 
     /// Gathers the candidates of the points in `cell`: the points of the 3^D cells around
@@ -157,7 +172,7 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
     /// needs), so that the next builds, whose pair counts differ by a few per cent, do not
     /// allocate: a step allocates nothing once the lists have grown (tested).
     fn keep_headroom(&mut self) {
-        let want = self.entries.len() + self.entries.len() / 4 + 256;
+        let want = self.pairs() + self.pairs() / 4 + 256;
         if self.entries.capacity() < want {
             self.entries.reserve(want - self.entries.len());
         }
@@ -218,7 +233,10 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let simd = filter::simd_available();
         self.chunks.par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
             |(c, (chunk, out))| {
-                chunk.clear();
+                // The entries and payload keep their length (the room of the last build):
+                // they only grow, so that no point's room is zeroed before it is written.
+                chunk.start.clear();
+                let mut len = 0;
                 // Points are visited in cell order, so the candidates of a cell serve every
                 // point in it.
                 let mut current = usize::MAX;
@@ -228,11 +246,11 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                         current = cell;
                         chunk.gather_candidates(cells, cell, points, shifts);
                     }
-                    let first = chunk.entries.len();
+                    let first = len;
                     chunk.start.push(first as u32);
                     let m = chunk.candidates.len();
                     // Room for every candidate plus one vector of lanes past the last.
-                    chunk.entries.resize(first + m + filter::LANES, 0);
+                    grow(&mut chunk.entries, first + m + filter::LANES);
                     chunk.r2.resize(m + filter::LANES, 0.0);
                     let c = filter::Candidates {
                         entries: &chunk.candidates,
@@ -246,20 +264,18 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                         r2max,
                         filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
                     );
-                    let len = first + accepted;
-                    chunk.entries.truncate(len);
+                    len = first + accepted;
                     // The payload over whole vectors: the pairs padded with copies of the search
                     // radius, whose values are then dropped (a scalar tail loop would cost as
                     // much as the vector body).
                     let padded = accepted.next_multiple_of(filter::LANES);
                     chunk.r2[accepted..padded].fill(r2max);
-                    chunk.payload.resize(first + padded, P::default());
-                    payload(&chunk.r2[..padded], &mut chunk.payload[first..]);
-                    chunk.payload.truncate(len);
-                    *out =
-                        reduce(Listed { entries: &chunk.entries[first..], payload: &chunk.payload[first..] });
+                    grow(&mut chunk.payload, first + padded);
+                    payload(&chunk.r2[..padded], &mut chunk.payload[first..first + padded]);
+                    let (entries, payload) = (&chunk.entries[first..len], &chunk.payload[first..len]);
+                    *out = reduce(Listed { entries, payload });
                 }
-                chunk.start.push(chunk.entries.len() as u32);
+                chunk.start.push(len as u32);
                 chunk.keep_headroom();
             },
         );
@@ -419,7 +435,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
 
     /// Total number of (ordered) pairs.
     pub fn pairs(&self) -> usize {
-        self.chunks.iter().map(|c| c.entries.len()).sum()
+        self.chunks.iter().map(Chunk::pairs).sum()
     }
 
     /// Bytes held by the lists.
