@@ -534,4 +534,39 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn a_rebuilt_list_holds_only_the_new_pairs() {
+        // One list built on a dense set, then on sparser and denser ones: the room a build
+        // leaves is reused, never read as pairs.
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
+        let d = Domain { min: [0.0, 0.0], max: [1.0, 1.0], periodic: [true, false] };
+        let radius = 0.08;
+        let mut nl = NeighbourList::<2, f64>::new();
+        for n in [2000, 300, 1200] {
+            let pts: Vec<Vector<2>> = (0..n).map(|_| Vector::<2>::new(rng.gen(), rng.gen())).collect();
+            let mut cells = CellList::new(d, radius);
+            cells.update(&pts);
+            let mut counts = vec![0usize; n];
+            nl.build_reducing(
+                &cells,
+                &pts,
+                |r2, out| out.copy_from_slice(r2),
+                &mut counts,
+                |l| l.iter().count(),
+            );
+            let brute = brute_force_neighbours(&d, radius, &pts, &pts);
+            for (i, expected) in brute.iter().enumerate() {
+                let mut v = Vec::new();
+                nl.for_each(i, &pts, |j, _, r2, &payload| {
+                    assert_eq!(payload, r2, "point {i} of {n}: the payload of this build");
+                    v.push(j);
+                });
+                assert_eq!(counts[i], v.len(), "the reduction saw the listed pairs only");
+                v.sort();
+                assert_eq!(&v, expected, "point {i} of {n}");
+            }
+            assert_eq!(nl.pairs(), brute.iter().map(Vec::len).sum::<usize>(), "{n} points");
+        }
+    }
 }
