@@ -1,11 +1,12 @@
 //! Runs any scene: progress, time series, snapshots, blow-up handling and the summary.
 
+use super::progress::Progress;
 use super::{params::Params, SceneEntry, SceneRun};
 
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
 use std::collections::BTreeMap;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -157,10 +158,12 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     // The columns of the rows written before a resume: a later build may sample others.
     let mut resumed_columns = (ts_rows > 0).then(|| header(&ts_path)).flatten();
 
-    let bar = progress_bar(opts.quiet);
+    let progress = Progress::new(opts.quiet, tf, scene.time(), scene.steps());
     let mut progress_file = ProgressFile::new(opts.progress_file.clone());
     let mut last_checkpoint = Instant::now();
     let particles = scene.particles() as f64;
+    // The particle-steps per second of the stepping so far, shown after each output.
+    let mut rate = String::new();
     let eps = 1e-12 * tf.max(1.0);
     let outcome = loop {
         let t = scene.time();
@@ -209,18 +212,13 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let target = next_sample.min(next_output).min(tf);
         let ts0 = Instant::now();
         let res = scene.advance(target, tf, &mut |time, steps| {
-            if let Some(b) = &bar {
-                b.set_position((time / tf * 1000.0) as u64);
-                b.set_message(format!("t = {time:.4}/{tf}  step {steps}"));
-            }
+            progress.update(time, steps, &rate);
             progress_file.update(time, tf, steps);
             !INTERRUPTED.load(Ordering::Relaxed) && opts.stop_after_steps.is_none_or(|n| steps < n)
         });
         stepping += ts0.elapsed().as_secs_f64();
-        if let Some(b) = &bar {
-            let rate = particles * scene.steps() as f64 / stepping.max(1e-9);
-            b.set_message(format!("t = {:.4}/{tf}  {rate:.3e} particle-steps/s", scene.time()));
-        }
+        rate = format!("{:.3e} particle-steps/s", particles * scene.steps() as f64 / stepping.max(1e-9));
+        progress.update(scene.time(), scene.steps(), &rate);
         let reached = match res {
             Ok(reached) => reached,
             Err(d) => {
@@ -257,9 +255,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             );
         }
     };
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    progress.finish();
     let (status, reason, metrics) = match &outcome {
         Outcome::Completed => (Status::Completed, None, scene.metrics()),
         Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), BTreeMap::new()),
@@ -378,18 +374,6 @@ fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
         out.push('\n');
     }
     crate::solver::output::write_atomic(path, out.as_bytes())
-}
-
-fn progress_bar(quiet: bool) -> Option<indicatif::ProgressBar> {
-    if quiet || !std::io::stderr().is_terminal() {
-        return None;
-    }
-    let bar = indicatif::ProgressBar::with_draw_target(Some(1000), indicatif::ProgressDrawTarget::stderr());
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {wide_bar} {msg}  eta {eta}")
-            .expect("valid template"),
-    );
-    Some(bar)
 }
 
 /// `time tf steps`, rewritten at most twice a second for a parent process to read.

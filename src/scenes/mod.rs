@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod harness;
 pub mod hydrostatic_tank;
 pub mod params;
+pub mod progress;
 pub mod taylor_green;
 
 use crate::solver::simulation::Divergence;
