@@ -202,7 +202,7 @@ enum Command {
         /// parameters there.
         #[arg(long)]
         force: bool,
-        /// Write `time tf steps` to this file about twice a second.
+        /// Write `time tf steps t0 seconds` to this file about twice a second.
         #[arg(long, hide = true)]
         progress_file: Option<PathBuf>,
         /// Write DIR/checkpoint.json every SECONDS of stepping (and on Ctrl-C); a run of

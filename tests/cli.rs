@@ -417,3 +417,39 @@ fn sigterm_and_sighup_stop_a_run_with_a_checkpoint_unless_hup_is_ignored() {
     assert_eq!(child.wait().unwrap().code(), Some(1));
     assert!(stopped(dir.path()));
 }
+
+/// The progress file a runner reads holds `time tf steps t0 seconds`: a fresh run starts
+/// from t0 = 0, its simulated time and wall seconds grow, and so the runner can pace it.
+#[test]
+fn the_progress_file_gives_the_pace_of_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let dir = dir.path();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_sphrepro"))
+        .args(["simulate", "taylor_green", "--quiet", "--set", "nx=24", "--set", "tf=50"])
+        .arg("--out")
+        .arg(dir)
+        .arg("--progress-file")
+        .arg(dir.join("progress"))
+        .spawn()
+        .unwrap();
+    let read = || -> Option<Vec<f64>> {
+        let text = std::fs::read_to_string(dir.join("progress")).ok()?;
+        let v: Vec<f64> = text.split_whitespace().filter_map(|x| x.parse().ok()).collect();
+        (v.len() == 5).then_some(v)
+    };
+    let t0 = Instant::now();
+    let mut seen: Vec<Vec<f64>> = Vec::new();
+    while seen.len() < 2 && t0.elapsed() < Duration::from_secs(60) {
+        if let Some(v) = read().filter(|v| seen.last().is_none_or(|l| l[4] < v[4])) {
+            seen.push(v);
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert_eq!(seen.len(), 2, "two readings of the progress file: {seen:?}");
+    let (a, b) = (&seen[0], &seen[1]);
+    assert_eq!((a[1], a[3]), (50.0, 0.0), "tf and the run's start time: {a:?}");
+    assert!(0.0 < a[0] && a[0] < b[0] && a[2] < b[2], "time and steps grow: {seen:?}");
+    assert!(0.0 < a[4] && a[4] < b[4], "wall seconds grow: {seen:?}");
+}

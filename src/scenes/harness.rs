@@ -22,7 +22,8 @@ pub struct RunOptions {
     /// Overwrite a finished run in the output folder, or discard the checkpoint of an
     /// interrupted run of other parameters.
     pub force: bool,
-    /// Write `time tf steps` here about twice a second (for a parent runner's progress).
+    /// Write `time tf steps t0 seconds` here about twice a second (for a parent runner's
+    /// progress; see `ProgressFile`).
     pub progress_file: Option<PathBuf>,
     /// Write `checkpoint.json` after at most this many wall-clock seconds of stepping
     /// (and always on Ctrl-C); a later run of the same case in the same folder resumes
@@ -159,7 +160,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let mut resumed_columns = (ts_rows > 0).then(|| header(&ts_path)).flatten();
 
     let progress = Progress::new(opts.quiet, tf, scene.time(), scene.steps());
-    let mut progress_file = ProgressFile::new(opts.progress_file.clone());
+    let mut progress_file = ProgressFile::new(opts.progress_file.clone(), scene.time());
     let mut last_checkpoint = Instant::now();
     let particles = scene.particles() as f64;
     // The particle-steps per second of the stepping so far, shown after each output.
@@ -376,15 +377,20 @@ fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
     crate::solver::output::write_atomic(path, out.as_bytes())
 }
 
-/// `time tf steps`, rewritten at most twice a second for a parent process to read.
+/// `time tf steps t0 seconds`, rewritten at most twice a second for a parent process to
+/// read: the simulated time, its end, the steps, and the simulated time this run started
+/// from (a resumed run's checkpoint) with the wall seconds it has taken since, its pace.
 struct ProgressFile {
     path: Option<PathBuf>,
     last: Instant,
+    start: Instant,
+    t0: f64,
 }
 
 impl ProgressFile {
-    fn new(path: Option<PathBuf>) -> Self {
-        Self { path, last: Instant::now() }
+    fn new(path: Option<PathBuf>, t0: f64) -> Self {
+        let now = Instant::now();
+        Self { path, last: now, start: now, t0 }
     }
 
     fn update(&mut self, time: f64, tf: f64, steps: u64) {
@@ -394,7 +400,7 @@ impl ProgressFile {
         }
         self.last = Instant::now();
         if let Ok(mut f) = std::fs::File::create(p) {
-            let _ = writeln!(f, "{time} {tf} {steps}");
+            let _ = writeln!(f, "{time} {tf} {steps} {} {}", self.t0, self.start.elapsed().as_secs_f64());
         }
     }
 }

@@ -78,12 +78,15 @@ fn line(
     format!("t = {t}/{tf}  step {steps}  {rate} steps/s  left {left}{extra}")
 }
 
-/// `1h 02m`, `3m 05s`, `12s`; past a hundred days, `> 100 d`.
+/// `1h 02m`, `3m 05s`, `12s` (to the nearest second), `<1s`; past a hundred days, `> 100 d`.
 pub fn duration(seconds: f64) -> String {
     if !seconds.is_finite() || seconds > 100.0 * 86_400.0 {
         return "> 100 d".into();
     }
-    let s = Duration::from_secs_f64(seconds.max(0.0)).as_secs();
+    if seconds < 0.5 {
+        return "<1s".into();
+    }
+    let s = Duration::from_secs_f64(seconds.round()).as_secs();
     match (s / 3600, s / 60 % 60, s % 60) {
         (h, _, _) if h >= 24 => format!("{}d {:02}h", h / 24, h % 24),
         (h, m, _) if h > 0 => format!("{h}h {m:02}m"),
@@ -120,6 +123,8 @@ mod tests {
         assert_eq!(duration(3725.0), "1h 02m");
         assert_eq!(duration(185.4), "3m 05s");
         assert_eq!(duration(12.0), "12s");
+        assert_eq!(duration(0.9), "1s");
+        assert_eq!(duration(0.2), "<1s");
         assert_eq!(duration(f64::INFINITY), "> 100 d");
         let msg = line(1.36e-5, 0.05, 21803, Some(7267.7), Some(left), "");
         assert_eq!(msg, "t = 1.360e-5/0.05  step 21803  7268 steps/s  left 3h 03m");
