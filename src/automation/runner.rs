@@ -8,7 +8,7 @@ use super::cache::{Entry, State};
 use super::lock::{Lock, Try};
 use super::registry::Problem;
 use crate::scenes::harness::INTERRUPTED;
-use crate::scenes::progress::{duration, time_left};
+use crate::scenes::progress::{duration, read_file};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::VecDeque;
 use std::io::IsTerminal;
@@ -279,18 +279,10 @@ fn run_one(
             let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
             signalled = true;
         }
-        if let Ok(s) = std::fs::read_to_string(&progress) {
-            let v: Vec<f64> = s.split_whitespace().filter_map(|x| x.parse().ok()).collect();
-            if v.len() >= 2 && v[1] > 0.0 {
-                // `time tf steps t0 seconds`: the pace since the case (re)started.
-                let left = match v[..] {
-                    [t, tf, _, t0, secs, ..] => time_left(secs, t0, t, tf),
-                    _ => None,
-                };
-                let left = left.map_or("?".into(), duration);
-                bar.set_position((v[0] / v[1] * 1000.0) as u64);
-                bar.set_message(format!("{}  t = {:.3}/{}  left {left}", e.case.name, v[0], v[1]));
-            }
+        if let Some((t, tf, left)) = std::fs::read_to_string(&progress).ok().as_deref().and_then(read_file) {
+            let left = left.map_or("?".into(), duration);
+            bar.set_position((t / tf * 1000.0) as u64);
+            bar.set_message(format!("{}  t = {t:.3}/{tf}  left {left}", e.case.name));
         }
         std::thread::sleep(Duration::from_millis(200));
     };

@@ -6,7 +6,6 @@ use super::{params::Params, SceneEntry, SceneRun};
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
 use std::collections::BTreeMap;
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
@@ -23,7 +22,7 @@ pub struct RunOptions {
     /// interrupted run of other parameters.
     pub force: bool,
     /// Write `time tf steps t0 seconds` here about twice a second (for a parent runner's
-    /// progress; see `ProgressFile`).
+    /// progress; see [`progress::read_file`](super::progress::read_file)).
     pub progress_file: Option<PathBuf>,
     /// Write `checkpoint.json` after at most this many wall-clock seconds of stepping
     /// (and always on Ctrl-C); a later run of the same case in the same folder resumes
@@ -159,8 +158,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     // The columns of the rows written before a resume: a later build may sample others.
     let mut resumed_columns = (ts_rows > 0).then(|| header(&ts_path)).flatten();
 
-    let progress = Progress::new(opts.quiet, tf, scene.time(), scene.steps());
-    let mut progress_file = ProgressFile::new(opts.progress_file.clone(), scene.time());
+    let mut progress = Progress::new(opts.quiet, opts.progress_file.clone(), tf, scene.time(), scene.steps());
     let mut last_checkpoint = Instant::now();
     let particles = scene.particles() as f64;
     // The particle-steps per second of the stepping so far, shown after each output.
@@ -214,7 +212,6 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let ts0 = Instant::now();
         let res = scene.advance(target, tf, &mut |time, steps| {
             progress.update(time, steps, &rate);
-            progress_file.update(time, tf, steps);
             !INTERRUPTED.load(Ordering::Relaxed) && opts.stop_after_steps.is_none_or(|n| steps < n)
         });
         stepping += ts0.elapsed().as_secs_f64();
@@ -375,34 +372,6 @@ fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
         out.push('\n');
     }
     crate::solver::output::write_atomic(path, out.as_bytes())
-}
-
-/// `time tf steps t0 seconds`, rewritten at most twice a second for a parent process to
-/// read: the simulated time, its end, the steps, and the simulated time this run started
-/// from (a resumed run's checkpoint) with the wall seconds it has taken since, its pace.
-struct ProgressFile {
-    path: Option<PathBuf>,
-    last: Instant,
-    start: Instant,
-    t0: f64,
-}
-
-impl ProgressFile {
-    fn new(path: Option<PathBuf>, t0: f64) -> Self {
-        let now = Instant::now();
-        Self { path, last: now, start: now, t0 }
-    }
-
-    fn update(&mut self, time: f64, tf: f64, steps: u64) {
-        let Some(p) = &self.path else { return };
-        if self.last.elapsed().as_millis() < 500 {
-            return;
-        }
-        self.last = Instant::now();
-        if let Ok(mut f) = std::fs::File::create(p) {
-            let _ = writeln!(f, "{time} {tf} {steps} {} {}", self.t0, self.start.elapsed().as_secs_f64());
-        }
-    }
 }
 
 #[cfg(test)]

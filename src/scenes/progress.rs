@@ -1,16 +1,22 @@
-//! The progress bar of a run on a terminal: simulated time, steps per second and the time
-//! left, estimated from the simulated time this run has covered so far (not from the bar's
-//! position, which cannot move while a run crawls through its first thousandth of `tf`).
+//! The progress of a run: a bar on the terminal (simulated time, steps per second and the
+//! time left) and a file a parent runner reads. The time left is estimated from the
+//! simulated time this run has covered so far (not from the bar's position, which cannot
+//! move while a run crawls through its first thousandth of `tf`).
 
+use std::io::Write;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// Positions of the bar from `t = 0` to `tf`: fine enough that a long run moves it.
 const LENGTH: u64 = 1_000_000;
 
-/// The bar of one run, started at simulated time `t0` after `steps0` steps (a resumed run
-/// starts where its checkpoint left off); `None` inside when quiet or not on a terminal.
+/// The progress of one run, started at simulated time `t0` after `steps0` steps (a resumed
+/// run starts where its checkpoint left off): its bar (none when quiet or not on a
+/// terminal) and its progress file (if asked for), rewritten at most twice a second.
 pub struct Progress {
     bar: Option<indicatif::ProgressBar>,
+    file: Option<PathBuf>,
+    last_write: Instant,
     tf: f64,
     start: Instant,
     t0: f64,
@@ -18,8 +24,9 @@ pub struct Progress {
 }
 
 impl Progress {
-    /// A bar on stderr, unless `quiet` or stderr is not a terminal.
-    pub fn new(quiet: bool, tf: f64, t0: f64, steps0: u64) -> Self {
+    /// A bar on stderr, unless `quiet` or stderr is not a terminal, and the progress file
+    /// `file`.
+    pub fn new(quiet: bool, file: Option<PathBuf>, tf: f64, t0: f64, steps0: u64) -> Self {
         use std::io::IsTerminal;
         let bar = (!quiet && std::io::stderr().is_terminal()).then(|| {
             let bar = indicatif::ProgressBar::with_draw_target(
@@ -32,17 +39,30 @@ impl Progress {
             );
             bar
         });
-        Self { bar, tf, start: Instant::now(), t0, steps0 }
+        let now = Instant::now();
+        Self { bar, file, last_write: now, tf, start: now, t0, steps0 }
     }
 
     /// Shows the run at simulated time `t` after `steps` steps in all; `extra` is appended
-    /// (e.g. the particle-steps per second of the stepping so far).
-    pub fn update(&self, t: f64, steps: u64, extra: &str) {
-        let Some(bar) = &self.bar else { return };
+    /// to the bar (e.g. the particle-steps per second of the stepping so far).
+    pub fn update(&mut self, t: f64, steps: u64, extra: &str) {
+        if self.bar.is_none() && self.file.is_none() {
+            return;
+        }
         let elapsed = self.start.elapsed().as_secs_f64();
-        bar.set_position(((t / self.tf).clamp(0.0, 1.0) * LENGTH as f64) as u64);
-        let rate = (elapsed > 0.0).then(|| steps.saturating_sub(self.steps0) as f64 / elapsed);
-        bar.set_message(line(t, self.tf, steps, rate, time_left(elapsed, self.t0, t, self.tf), extra));
+        if let Some(bar) = &self.bar {
+            bar.set_position(((t / self.tf).clamp(0.0, 1.0) * LENGTH as f64) as u64);
+            let rate = (elapsed > 0.0).then(|| steps.saturating_sub(self.steps0) as f64 / elapsed);
+            bar.set_message(line(t, self.tf, steps, rate, time_left(elapsed, self.t0, t, self.tf), extra));
+        }
+        if let Some(path) = &self.file {
+            if self.last_write.elapsed().as_millis() >= 500 {
+                self.last_write = Instant::now();
+                if let Ok(mut f) = std::fs::File::create(path) {
+                    let _ = writeln!(f, "{t} {} {steps} {} {elapsed}", self.tf, self.t0);
+                }
+            }
+        }
     }
 
     /// Removes the bar.
@@ -50,6 +70,17 @@ impl Progress {
         if let Some(bar) = &self.bar {
             bar.finish_and_clear();
         }
+    }
+}
+
+/// A progress file's `time tf steps t0 seconds` (the simulated time this run started from
+/// and the wall seconds it has taken since): `(time, tf, seconds left)`; `None` if the
+/// file is not (yet) whole.
+pub fn read_file(text: &str) -> Option<(f64, f64, Option<f64>)> {
+    let v: Vec<f64> = text.split_whitespace().map(|x| x.parse().ok()).collect::<Option<_>>()?;
+    match v[..] {
+        [t, tf, _, t0, seconds] if tf > 0.0 => Some((t, tf, time_left(seconds, t0, t, tf))),
+        _ => None,
     }
 }
 
@@ -108,6 +139,16 @@ mod tests {
         // A resumed run is paced by what it covered itself, from t0.
         assert_eq!(time_left(10.0, 1.0, 1.5, 2.0), Some(10.0));
         assert_eq!(time_left(10.0, 0.0, 2.0, 2.0), Some(0.0));
+    }
+
+    #[test]
+    fn a_progress_file_reads_back_with_its_pace() {
+        assert_eq!(read_file("0.5 2 40 0 10\n"), Some((0.5, 2.0, Some(30.0))));
+        assert_eq!(read_file("1.5 2 40 1 10"), Some((1.5, 2.0, Some(10.0))));
+        assert_eq!(read_file("0 2 0 0 0.1"), Some((0.0, 2.0, None)));
+        for partial in ["", "0.5 2 40", "0.5 2 40 0 1x", "0.5 0 40 0 10"] {
+            assert_eq!(read_file(partial), None, "{partial:?}");
+        }
     }
 
     #[test]
