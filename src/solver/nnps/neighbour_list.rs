@@ -230,7 +230,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         let shifts = &self.shifts;
         let r2max = cells.radius2();
-        let simd = filter::simd_available();
+        let path = filter::Path::fastest();
         self.chunks.par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
             |(c, (chunk, out))| {
                 // The entries and payload keep their length (the room of the last build):
@@ -258,7 +258,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                         shift: &chunk.candidate_shift,
                     };
                     let accepted = filter::within(
-                        simd,
+                        path,
                         &points[i],
                         &c,
                         r2max,
