@@ -31,12 +31,22 @@ pub enum Path {
 }
 
 impl Path {
-    /// The fastest path this CPU runs.
+    /// The fastest path this CPU runs (without allocating: every list build asks).
     pub fn fastest() -> Path {
-        Self::available().pop().unwrap_or(Path::Portable)
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                return Path::Avx512;
+            }
+            if std::arch::is_x86_feature_detected!("avx2") {
+                return Path::Avx2;
+            }
+        }
+        Path::Portable
     }
 
-    /// Every path this CPU runs, slowest first.
+    /// Every path this CPU runs, slowest first (for the tests, which compare them all).
+    #[cfg(test)]
     pub fn available() -> Vec<Path> {
         let mut paths = vec![Path::Portable];
         #[cfg(target_arch = "x86_64")]
@@ -60,7 +70,7 @@ pub struct Accepted<'a> {
 }
 
 /// Writes the candidates within `sqrt(r2max)` of `xi` to `out` and returns how many.
-/// `path` must be one of [`Path::available`].
+/// A `path` this CPU cannot run falls back to the portable one.
 pub fn within<const D: usize>(
     path: Path,
     xi: &Vector<D>,
@@ -71,15 +81,20 @@ pub fn within<const D: usize>(
     let m = c.entries.len();
     assert!(c.x.len() == D * m && c.shift.len() == D * m, "one position and shift per candidate and axis");
     assert!(out.entries.len() >= m + LANES && out.r2.len() >= m + LANES, "room past the last candidate");
-    // SAFETY (both vector paths): the CPU has the features (the caller took `path` from
-    // `Path::available`), and the lengths were checked above: every load reads lanes below
+    // SAFETY (both vector paths): the CPU has the feature (checked here: a cached bit, cheap
+    // against a point's ~80 candidates, and it keeps this function sound whatever `path`
+    // a caller passes), and the lengths were checked above: every load reads lanes below
     // `m` (AVX-512 masks the others off; AVX2 leaves a partial vector to the portable
     // loop), every store writes a full vector at an index at most `m`.
     #[cfg(target_arch = "x86_64")]
     match path {
-        Path::Avx512 => return unsafe { avx512::within(xi, c, r2max, out) },
-        Path::Avx2 => return unsafe { avx2::within(xi, c, r2max, out) },
-        Path::Portable => {}
+        Path::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
+            return unsafe { avx512::within(xi, c, r2max, out) }
+        }
+        Path::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
+            return unsafe { avx2::within(xi, c, r2max, out) }
+        }
+        _ => {}
     }
     let _ = path;
     portable(xi, c, r2max, out, 0, 0)
@@ -250,6 +265,7 @@ mod tests {
                 }
             }
             assert_eq!(e.iter().copied().zip(r2.iter().copied()).collect::<Vec<_>>(), expect, "m = {m}");
+            assert_eq!(Path::available().last(), Some(&Path::fastest()));
             for path in Path::available() {
                 assert_eq!(run(path), (e.clone(), r2.clone()), "{path:?}, m = {m}");
             }
