@@ -678,7 +678,9 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
         }
     }
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1:\n");
+    // The distance test's path explains a host's share of the neighbour list (session 23).
+    let test = sphrepro::solver::nnps::DistanceTest::fastest().name();
+    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, distance test {test}:\n");
     println!("{}", bench::table(&results, &peers));
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {

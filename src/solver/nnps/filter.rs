@@ -25,8 +25,11 @@ pub struct Candidates<'a> {
 /// The implementation of the test; every one gives the same result.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Path {
+    /// Scalar, on any CPU.
     Portable,
+    /// Four candidates a vector (x86-64 with AVX2).
     Avx2,
+    /// Eight candidates a vector (x86-64 with AVX-512F).
     Avx512,
 }
 
@@ -43,6 +46,15 @@ impl Path {
             }
         }
         Path::Portable
+    }
+
+    /// Its name, as the bench prints it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Path::Portable => "portable",
+            Path::Avx2 => "avx2",
+            Path::Avx512 => "avx512",
+        }
     }
 
     /// Every path this CPU runs, slowest first (for the tests, which compare them all).

@@ -17,6 +17,8 @@ mod slabs;
 
 pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
+/// The implementations of the list build's distance test (same bits; the fastest is used).
+pub use filter::Path as DistanceTest;
 pub use neighbour_list::{HalfPairs, Listed, NeighbourList, PairSlices};
 pub use slabs::{PerPoint, Slabs};
 
