@@ -678,7 +678,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
         }
     }
-    // The distance test's path explains a host's share of the neighbour list (session 23).
+    // Which distance test ran: without a vector path the neighbour list costs hosts more.
     let test = sphrepro::solver::nnps::DistanceTest::fastest().name();
     println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, distance test {test}:\n");
     println!("{}", bench::table(&results, &peers));

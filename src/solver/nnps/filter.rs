@@ -34,18 +34,25 @@ pub enum Path {
 }
 
 impl Path {
-    /// The fastest path this CPU runs (without allocating: every list build asks).
-    pub fn fastest() -> Path {
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                return Path::Avx512;
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                return Path::Avx2;
-            }
+    /// Every path, slowest first.
+    const ALL: [Path; 3] = [Path::Portable, Path::Avx2, Path::Avx512];
+
+    /// Whether this CPU runs the path (a cached bit: cheap enough to ask for every point).
+    pub fn runs(self) -> bool {
+        match self {
+            Path::Portable => true,
+            #[cfg(target_arch = "x86_64")]
+            Path::Avx2 => std::arch::is_x86_feature_detected!("avx2"),
+            #[cfg(target_arch = "x86_64")]
+            Path::Avx512 => std::arch::is_x86_feature_detected!("avx512f"),
+            #[cfg(not(target_arch = "x86_64"))]
+            _ => false,
         }
-        Path::Portable
+    }
+
+    /// The fastest path this CPU runs.
+    pub fn fastest() -> Path {
+        Self::ALL.into_iter().rev().find(|p| p.runs()).unwrap_or(Path::Portable)
     }
 
     /// Its name, as the bench prints it.
@@ -60,17 +67,7 @@ impl Path {
     /// Every path this CPU runs, slowest first (for the tests, which compare them all).
     #[cfg(test)]
     pub fn available() -> Vec<Path> {
-        let mut paths = vec![Path::Portable];
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::arch::is_x86_feature_detected!("avx2") {
-                paths.push(Path::Avx2);
-            }
-            if std::arch::is_x86_feature_detected!("avx512f") {
-                paths.push(Path::Avx512);
-            }
-        }
-        paths
+        Self::ALL.into_iter().filter(|p| p.runs()).collect()
     }
 }
 
@@ -93,19 +90,14 @@ pub fn within<const D: usize>(
     let m = c.entries.len();
     assert!(c.x.len() == D * m && c.shift.len() == D * m, "one position and shift per candidate and axis");
     assert!(out.entries.len() >= m + LANES && out.r2.len() >= m + LANES, "room past the last candidate");
-    // SAFETY (both vector paths): the CPU has the feature (checked here: a cached bit, cheap
-    // against a point's ~80 candidates, and it keeps this function sound whatever `path`
-    // a caller passes), and the lengths were checked above: every load reads lanes below
+    // SAFETY (both vector paths): the CPU has the feature (checked here by `runs`, so that
+    // this function stays sound whatever `path` a caller passes), and the lengths were checked above: every load reads lanes below
     // `m` (AVX-512 masks the others off; AVX2 leaves a partial vector to the portable
     // loop), every store writes a full vector at an index at most `m`.
     #[cfg(target_arch = "x86_64")]
     match path {
-        Path::Avx512 if std::arch::is_x86_feature_detected!("avx512f") => {
-            return unsafe { avx512::within(xi, c, r2max, out) }
-        }
-        Path::Avx2 if std::arch::is_x86_feature_detected!("avx2") => {
-            return unsafe { avx2::within(xi, c, r2max, out) }
-        }
+        Path::Avx512 if path.runs() => return unsafe { avx512::within(xi, c, r2max, out) },
+        Path::Avx2 if path.runs() => return unsafe { avx2::within(xi, c, r2max, out) },
         _ => {}
     }
     let _ = path;
@@ -250,6 +242,7 @@ mod tests {
 
     #[test]
     fn vector_and_portable_paths_agree_bit_for_bit() {
+        assert_eq!(Path::available().last(), Some(&Path::fastest()));
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(4);
         for m in [0, 1, 3, 4, 5, 7, 8, 9, 63, 81, 400] {
             let entries: Vec<u32> = (0..m as u32).map(|k| k * 3 + 1).collect();
@@ -277,7 +270,6 @@ mod tests {
                 }
             }
             assert_eq!(e.iter().copied().zip(r2.iter().copied()).collect::<Vec<_>>(), expect, "m = {m}");
-            assert_eq!(Path::available().last(), Some(&Path::fastest()));
             for path in Path::available() {
                 assert_eq!(run(path), (e.clone(), r2.clone()), "{path:?}, m = {m}");
             }
