@@ -678,9 +678,10 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             }
         }
     }
-    // Which distance test ran: without a vector path the neighbour list costs hosts more.
-    let test = sphrepro::solver::nnps::DistanceTest::fastest().name();
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, distance test {test}:\n");
+    // The host and build: figures compare only within one kind of host, and without a
+    // vector path for the distance test the neighbour list costs a host more.
+    let host = sphrepro::host::Host::detect();
+    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", host.describe());
     println!("{}", bench::table(&results, &peers));
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {
@@ -688,11 +689,9 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     }
-    let text = if peers.is_empty() {
-        serde_json::to_string_pretty(&results)
-    } else {
-        serde_json::to_string_pretty(&serde_json::json!({ "results": results, "peers": peers }))
-    }
+    let text = serde_json::to_string_pretty(
+        &serde_json::json!({ "host": host, "results": results, "peers": peers }),
+    )
     .expect("serialises");
     if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {
         eprintln!("error: {}: {e}", json.display());

@@ -339,7 +339,7 @@ fn bench_interleaves_the_cases_of_a_size() {
         .unwrap();
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    let rows: Vec<_> = v
+    let rows: Vec<_> = v["results"]
         .as_array()
         .unwrap()
         .iter()
@@ -352,7 +352,16 @@ fn bench_interleaves_the_cases_of_a_size() {
         })
         .collect();
     assert_eq!(rows, [("edac", 1, 3), ("edac", 2, 3), ("ctvf+sun", 1, 3), ("ctvf+sun", 2, 3)]);
+    // One shape with or without a peer: the host and build the sitting ran on, named in
+    // the title too.
+    let host = &v["host"];
+    assert_eq!(host["sphrepro_version"], env!("CARGO_PKG_VERSION"));
+    assert!(host["logical_cpus"].as_u64().unwrap() >= 1);
+    assert_eq!(v["peers"].as_array().map(Vec::len), Some(0));
     let table = String::from_utf8_lossy(&out.stdout);
+    let test = host["distance_test"].as_str().unwrap();
+    let title = format!("model {}", host["cpu_model"]);
+    assert!(table.contains(&title) && table.contains(&format!("distance test {test}:")), "{table}");
     // The cost of ctvf+sun and the speed-up with their ranges over the rounds.
     let sun = table.lines().find(|l| l.starts_with("| ctvf+sun | 16 | 256 | 2 |")).unwrap();
     assert_eq!(sun.matches(") |").count(), 3, "{sun}");
