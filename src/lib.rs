@@ -14,6 +14,5 @@
 
 pub mod automation;
 pub mod bench;
-pub mod host;
 pub mod scenes;
 pub mod solver;

@@ -559,6 +559,7 @@ fn peer_run(
 fn run_bench(args: BenchArgs) -> ExitCode {
     let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel, interleave } =
         args;
+    let started = chrono::Utc::now();
     let kernel = kernel.as_str();
     if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
         eprintln!(
@@ -680,8 +681,8 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     }
     // The host and build: figures compare only within one kind of host, and without a
     // vector path for the distance test the neighbour list costs a host more.
-    let host = sphrepro::host::Host::detect();
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", host.describe());
+    let provenance = sphrepro::solver::output::summary::Provenance::now(started);
+    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", provenance.machine.describe());
     println!("{}", bench::table(&results, &peers));
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {
@@ -690,7 +691,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
         }
     }
     let text = serde_json::to_string_pretty(
-        &serde_json::json!({ "host": host, "results": results, "peers": peers }),
+        &serde_json::json!({ "provenance": provenance, "results": results, "peers": peers }),
     )
     .expect("serialises");
     if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {

@@ -177,6 +177,11 @@ fn a_completed_run_writes_the_contracted_outputs() {
     for k in ["version", "git_commit", "rustc", "host", "started", "finished"] {
         assert!(s["provenance"][k].is_string(), "provenance lacks {k}");
     }
+    // The machine, so that wall times are read against the kind of host they ran on.
+    for k in ["cpu_vendor", "cpu_brand", "compiled_simd", "distance_test"] {
+        assert!(s["provenance"]["machine"][k].is_string(), "machine lacks {k}");
+    }
+    assert!(s["provenance"]["machine"]["logical_cpus"].as_u64().unwrap() >= 1);
     let ts = std::fs::read_to_string(dir.path().join("timeseries.csv")).unwrap();
     assert!(ts.lines().next().unwrap().starts_with("t,u_max,u_max_exact,l1_velocity"));
     assert!(ts.lines().count() > 10);
@@ -352,10 +357,10 @@ fn bench_interleaves_the_cases_of_a_size() {
         })
         .collect();
     assert_eq!(rows, [("edac", 1, 3), ("edac", 2, 3), ("ctvf+sun", 1, 3), ("ctvf+sun", 2, 3)]);
-    // One shape with or without a peer: the host and build the sitting ran on, named in
-    // the title too.
-    let host = &v["host"];
-    assert_eq!(host["sphrepro_version"], env!("CARGO_PKG_VERSION"));
+    // One shape with or without a peer: the provenance of the sitting (the build, and the
+    // machine, named in the title too).
+    let (build, host) = (&v["provenance"], &v["provenance"]["machine"]);
+    assert_eq!(build["version"], env!("CARGO_PKG_VERSION"));
     assert!(host["logical_cpus"].as_u64().unwrap() >= 1);
     assert_eq!(v["peers"].as_array().map(Vec::len), Some(0));
     let table = String::from_utf8_lossy(&out.stdout);

@@ -8,6 +8,7 @@
 use super::cache::Entry;
 use super::registry::{Case, Figure, FigureKind, Problem, Select, Table};
 use super::report::{self, Item, Outcome, Section, Series, SeriesStyle};
+use crate::solver::output::machine::Machine;
 use crate::solver::output::summary::{Status, Summary};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -236,6 +237,23 @@ fn missing_note(rs: &[Run]) -> String {
         String::new()
     } else {
         format!(" No result for: {}.", m.join(", "))
+    }
+}
+
+/// The kinds of CPU the wall times of a figure were measured on (the cache keeps results
+/// from machine to machine): wall times compare only within one.
+fn machines_note<'a>(machines: impl IntoIterator<Item = &'a Machine>) -> String {
+    let mut kinds: Vec<String> = machines.into_iter().map(Machine::cpu).collect();
+    kinds.sort();
+    kinds.dedup();
+    match kinds.as_slice() {
+        [] => String::new(),
+        [one] => format!(" Wall times on {one}."),
+        many => format!(
+            " Wall times from {} kinds of CPU ({}): compare them only within one.",
+            many.len(),
+            many.join("; ")
+        ),
     }
 }
 
@@ -515,9 +533,16 @@ fn trade(
             caption: format!("{caption} ({what})"),
             paper: f.paper.clone(),
             ours: format!(
-                "Pareto front ({what}): {}.{}",
+                "Pareto front ({what}): {}.{}{}",
                 if names.is_empty() { "none".into() } else { names.join("; ") },
-                missing_note(rs)
+                missing_note(rs),
+                if idx == 0 {
+                    machines_note(
+                        done.iter().map(|d| &d.0.summary.as_ref().expect("done").provenance.machine),
+                    )
+                } else {
+                    String::new()
+                }
             ),
         });
     }
@@ -747,6 +772,19 @@ paper = "Fig. 14a"
 
     /// A profile figure: one curve per case that has a result and the file, the
     /// reference drawn as points, the manuscript line with the metric and the claim.
+    #[test]
+    fn the_wall_times_name_their_kinds_of_cpu() {
+        let here = Machine::detect();
+        let other = Machine { cpu_model: here.cpu_model + 1, ..here.clone() };
+        assert_eq!(machines_note([&here, &here]), format!(" Wall times on {}.", here.cpu()));
+        let mixed = machines_note([&here, &other, &Machine::default()]);
+        assert!(
+            mixed.starts_with(" Wall times from 3 kinds of CPU (") && mixed.contains("not recorded"),
+            "{mixed}"
+        );
+        assert_eq!(machines_note([]), "");
+    }
+
     #[test]
     fn profile_figure_from_case_files_and_reference() {
         let root = tempfile::tempdir().unwrap();

@@ -1,6 +1,7 @@
 //! Run output: ParaView snapshots (`.vtu` plus a `.pvd` series), the run summary
 //! (`summary.json`, written atomically) and its provenance.
 
+pub mod machine;
 pub mod summary;
 pub mod vtu;
 

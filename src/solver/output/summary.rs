@@ -31,6 +31,10 @@ pub struct Provenance {
     pub rustc: String,
     /// Host name.
     pub host: String,
+    /// Its CPU, and the vector paths the binary takes on it (absent from results written
+    /// before it was recorded).
+    #[serde(default)]
+    pub machine: super::machine::Machine,
     /// Start, RFC 3339.
     pub started: String,
     /// End, RFC 3339.
@@ -70,6 +74,7 @@ impl Provenance {
             git_dirty: env!("SPHREPRO_GIT_DIRTY") == "true",
             rustc: env!("SPHREPRO_RUSTC").into(),
             host: hostname(),
+            machine: super::machine::Machine::detect(),
             started: started.to_rfc3339(),
             finished: chrono::Utc::now().to_rfc3339(),
         }
@@ -128,5 +133,20 @@ impl Summary {
         let path = dir.join("summary.json");
         let s = std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
         serde_json::from_str(&s).map_err(|e| format!("{}: {e}", path.display()))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Results written before the machine was recorded still read (the cache keeps them).
+    #[test]
+    fn a_provenance_without_the_machine_reads_back() {
+        let mut p = serde_json::to_value(Provenance::now(chrono::Utc::now())).unwrap();
+        assert!(p["machine"]["logical_cpus"].as_u64().unwrap() >= 1);
+        p.as_object_mut().unwrap().remove("machine");
+        let old: Provenance = serde_json::from_value(p).unwrap();
+        assert_eq!(old.machine, super::super::machine::Machine::default());
     }
 }

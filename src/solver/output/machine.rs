@@ -1,13 +1,13 @@
-//! The machine a sitting ran on, and the build that ran: `sphrepro bench` writes it with
-//! its figures, because throughput is only comparable within one kind of host (the
-//! README's throughput table is kept per CPU family and model), and the same source runs
-//! its pair loops on different vector widths from host to host (`target-cpu=native`).
+//! The machine a run or a bench sitting ran on, part of its provenance: wall times and
+//! throughput only compare within one kind of host (the README's throughput table is kept
+//! per CPU family and model), and the same source runs its pair loops on different vector
+//! widths from host to host (`target-cpu=native`).
 
 use serde::{Deserialize, Serialize};
 
-/// The host and the build of a sitting.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Host {
+/// The CPU a result was computed on and what the binary made of it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
     /// CPU vendor (`GenuineIntel`, `AuthenticAMD`; empty off x86-64).
     pub cpu_vendor: String,
     /// CPU brand string (virtual machines often give a generic one, hence the numbers).
@@ -23,14 +23,10 @@ pub struct Host {
     pub compiled_simd: String,
     /// The path the neighbour lists' distance test takes on this CPU.
     pub distance_test: String,
-    /// The crate version and the git commit the binary was built from.
-    pub sphrepro_version: String,
-    /// See `sphrepro_version`.
-    pub git_commit: String,
 }
 
-impl Host {
-    /// This machine and this binary.
+impl Machine {
+    /// This machine, as this binary runs on it.
     pub fn detect() -> Self {
         let (cpu_vendor, cpu_brand, cpu_family, cpu_model) = cpu();
         Self {
@@ -41,20 +37,26 @@ impl Host {
             logical_cpus: std::thread::available_parallelism().map_or(1, |n| n.get()),
             compiled_simd: compiled_simd().into(),
             distance_test: crate::solver::nnps::DistanceTest::fastest().name().into(),
-            sphrepro_version: env!("CARGO_PKG_VERSION").into(),
-            git_commit: env!("SPHREPRO_GIT_COMMIT").into(),
         }
+    }
+
+    /// The kind of CPU: `GenuineIntel family 6 model 207 (Intel(R) Xeon(R) Processor)`, or
+    /// `not recorded` for results written before it was.
+    pub fn cpu(&self) -> String {
+        if *self == Self::default() {
+            return "not recorded".into();
+        }
+        let brand = if self.cpu_brand.is_empty() { String::new() } else { format!(" ({})", self.cpu_brand) };
+        let vendor = if self.cpu_vendor.is_empty() { "unknown CPU" } else { &self.cpu_vendor };
+        format!("{vendor} family {} model {}{brand}", self.cpu_family, self.cpu_model)
     }
 
     /// One line for a table's title: `GenuineIntel family 6 model 207 (Intel(R) Xeon(R)
     /// Processor), 2 logical CPUs, compiled for avx512f, distance test avx512`.
     pub fn describe(&self) -> String {
-        let brand = if self.cpu_brand.is_empty() { String::new() } else { format!(" ({})", self.cpu_brand) };
         format!(
-            "{} family {} model {}{brand}, {} logical CPUs, compiled for {}, distance test {}",
-            if self.cpu_vendor.is_empty() { "unknown CPU" } else { &self.cpu_vendor },
-            self.cpu_family,
-            self.cpu_model,
+            "{}, {} logical CPUs, compiled for {}, distance test {}",
+            self.cpu(),
             self.logical_cpus,
             self.compiled_simd,
             self.distance_test
@@ -129,7 +131,7 @@ mod tests {
 
     #[test]
     fn this_host_is_described() {
-        let h = Host::detect();
+        let h = Machine::detect();
         assert!(h.logical_cpus >= 1);
         assert!(["avx512", "avx2", "portable"].contains(&h.distance_test.as_str()));
         if cfg!(target_arch = "x86_64") {
@@ -138,5 +140,6 @@ mod tests {
         let line = h.describe();
         assert!(line.contains(&format!("family {} model {}", h.cpu_family, h.cpu_model)), "{line}");
         assert!(line.contains(&format!("distance test {}", h.distance_test)), "{line}");
+        assert_eq!(Machine::default().cpu(), "not recorded");
     }
 }
