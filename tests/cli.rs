@@ -391,14 +391,15 @@ fn sigterm_and_sighup_stop_a_run_with_a_checkpoint_unless_hup_is_ignored() {
         let mut c = Command::new(env!("CARGO_BIN_EXE_sphrepro"));
         c.args(["simulate", "taylor_green", "--quiet", "--set", "nx=24", "--set", "tf=50"]);
         c.arg("--out").arg(dir).arg("--progress-file").arg(dir.join("progress"));
-        if ignore_hup {
-            // SAFETY: only `signal` between fork and exec, async-signal-safe.
-            unsafe {
-                c.pre_exec(|| {
-                    libc::signal(libc::SIGHUP, libc::SIG_IGN);
-                    Ok(())
-                });
-            }
+        // Set in both cases, so that the test does not depend on how it was started (under
+        // `nohup`, the disposition every child inherits is "ignored").
+        let hup = if ignore_hup { libc::SIG_IGN } else { libc::SIG_DFL };
+        // SAFETY: only `signal` between fork and exec, async-signal-safe.
+        unsafe {
+            c.pre_exec(move || {
+                libc::signal(libc::SIGHUP, hup);
+                Ok(())
+            });
         }
         let child = c.spawn().unwrap();
         let t0 = Instant::now();
