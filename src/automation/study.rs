@@ -496,6 +496,8 @@ fn trade(
             Some((r, e, s.wall_seconds, s.particles as f64 * s.steps as f64))
         })
         .collect();
+    let machines =
+        machines_note(done.iter().map(|d| &d.0.summary.as_ref().expect("done").provenance.machine));
     let mut items = Vec::new();
     for (suffix, what, idx) in [("wall", "wall time (s)", 0), ("steps", "particle-steps (-)", 1)] {
         let id = format!("{}_{suffix}", f.id);
@@ -536,13 +538,7 @@ fn trade(
                 "Pareto front ({what}): {}.{}{}",
                 if names.is_empty() { "none".into() } else { names.join("; ") },
                 missing_note(rs),
-                if idx == 0 {
-                    machines_note(
-                        done.iter().map(|d| &d.0.summary.as_ref().expect("done").provenance.machine),
-                    )
-                } else {
-                    String::new()
-                }
+                if idx == 0 { machines.as_str() } else { "" }
             ),
         });
     }
@@ -770,8 +766,8 @@ caption = "u profiles"
 paper = "Fig. 14a"
 "#;
 
-    /// A profile figure: one curve per case that has a result and the file, the
-    /// reference drawn as points, the manuscript line with the metric and the claim.
+    /// The trade figures' note on the kinds of CPU of their wall times: one, several (with
+    /// results that predate the record), none.
     #[test]
     fn the_wall_times_name_their_kinds_of_cpu() {
         let here = Machine::detect();
@@ -785,6 +781,8 @@ paper = "Fig. 14a"
         assert_eq!(machines_note([]), "");
     }
 
+    /// A profile figure: one curve per case that has a result and the file, the
+    /// reference drawn as points, the manuscript line with the metric and the claim.
     #[test]
     fn profile_figure_from_case_files_and_reference() {
         let root = tempfile::tempdir().unwrap();

@@ -91,9 +91,10 @@ pub fn within<const D: usize>(
     assert!(c.x.len() == D * m && c.shift.len() == D * m, "one position and shift per candidate and axis");
     assert!(out.entries.len() >= m + LANES && out.r2.len() >= m + LANES, "room past the last candidate");
     // SAFETY (both vector paths): the CPU has the feature (checked here by `runs`, so that
-    // this function stays sound whatever `path` a caller passes), and the lengths were checked above: every load reads lanes below
-    // `m` (AVX-512 masks the others off; AVX2 leaves a partial vector to the portable
-    // loop), every store writes a full vector at an index at most `m`.
+    // this function stays sound whatever `path` a caller passes), and the lengths were
+    // checked above: every load reads lanes below `m` (AVX-512 masks the others off; AVX2
+    // leaves a partial vector to the portable loop), every store writes a full vector at
+    // an index at most `m`.
     #[cfg(target_arch = "x86_64")]
     match path {
         Path::Avx512 if path.runs() => return unsafe { avx512::within(xi, c, r2max, out) },
