@@ -119,11 +119,12 @@ fn cpu() -> (String, String, u32, u32) {
 mod tests {
     use super::*;
 
-    /// The signatures of the four kinds of host in docs/throughput.md (stepping 0).
+    /// The signatures of the kinds of host in docs/throughput.md (stepping 0).
     #[test]
     fn family_and_model_combine_the_extended_fields() {
         assert_eq!(family_model(0x000c_06f0), (6, 207), "Intel Xeon, the issue's kind");
         assert_eq!(family_model(0x00a0_0f10), (25, 1), "AMD Zen 3");
+        assert_eq!(family_model(0x00a1_0f10), (25, 17), "AMD Zen 4");
         assert_eq!(family_model(0x00b0_0f20), (26, 2), "AMD Zen 5");
         // Below family 6 the extended model is not part of the model.
         assert_eq!(family_model(0x0001_0520), (5, 2));
