@@ -222,9 +222,17 @@ impl ScaledKernel {
     /// neighbour lists evaluate all their pairs at once, in a loop the compiler vectorises
     /// (the kernel's match is outside it; the values equal the one-pair call bit for bit).
     pub fn w_and_grad_factor_batch(&self, r2: &[f64], out: &mut [(f64, f64)]) {
+        self.w_and_grad_factor_map(r2, out, |_, w, f| (w, f));
+    }
+
+    /// `out[k] = f(r2[k], W, (1/r) dW/dr)` at `sqrt(r2[k])`, in one loop the compiler
+    /// vectorises, for payloads that hold more of a pair than the kernel's two values.
+    #[inline(always)]
+    pub fn w_and_grad_factor_map<Y>(&self, r2: &[f64], out: &mut [Y], f: impl Fn(f64, f64, f64) -> Y) {
         with_shape!(self.kernel.kind, shape => {
             for (o, &r2) in out.iter_mut().zip(r2) {
-                *o = self.w_and_grad_factor_with(r2.sqrt(), shape);
+                let (w, g) = self.w_and_grad_factor_with(r2.sqrt(), shape);
+                *o = f(r2, w, g);
             }
         })
     }

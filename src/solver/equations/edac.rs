@@ -39,7 +39,7 @@ pub fn transport_correction<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pai
 /// which the authors' code keeps.
 #[inline(always)]
 pub fn diffusion<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, nu: f64) -> f64 {
-    b.v() * 2.0 * nu * (a.p - b.p) * ab.xij.dot(&ab.dwij) * ab.inv_r2_eps
+    b.v() * 2.0 * nu * (a.p - b.p) * ab.lap
 }
 
 #[cfg(test)]

@@ -32,6 +32,16 @@ pub struct Pair<const D: usize> {
     pub dwij: Vector<D>,
     /// 1 / (r^2 + 0.01 h^2), the regularised inverse distance of eqs. (26), (27), (29).
     pub inv_r2_eps: f64,
+    /// `x_ab . grad W / (r^2 + 0.01 h^2)`, the factor of the Morris-form Laplacians
+    /// (eqs. 26 and 27), from the kernel's gradient factor as [`regularised_laplacian`].
+    pub lap: f64,
+}
+
+/// `x_ab . grad W / (r^2 + 0.01 h^2) = f r^2 / (r^2 + 0.01 h^2)` with `f = (1/r) dW/dr`:
+/// computed with the kernel values of the list, where it vectorises.
+#[inline(always)]
+pub fn regularised_laplacian(grad_factor: f64, r2: f64, h: f64) -> f64 {
+    grad_factor * r2 / (r2 + eps2(h))
 }
 
 impl<const D: usize> Pair<D> {
@@ -39,7 +49,13 @@ impl<const D: usize> Pair<D> {
     /// factor `(1/r) dW/dr`.
     #[inline(always)]
     pub fn new(xij: Vector<D>, r2: f64, h: f64, wij: f64, grad_factor: f64) -> Self {
-        Self { xij, r2, h, wij, dwij: xij * grad_factor, inv_r2_eps: 1.0 / (r2 + eps2(h)) }
+        Self::with_laplacian(xij, r2, h, wij, grad_factor, regularised_laplacian(grad_factor, r2, h))
+    }
+
+    /// As [`new`](Self::new), with the Laplacian factor `lap` already computed.
+    #[inline(always)]
+    pub fn with_laplacian(xij: Vector<D>, r2: f64, h: f64, wij: f64, grad_factor: f64, lap: f64) -> Self {
+        Self { xij, r2, h, wij, dwij: xij * grad_factor, inv_r2_eps: 1.0 / (r2 + eps2(h)), lap }
     }
 }
 

@@ -8,7 +8,7 @@ use crate::solver::math::Vector;
 /// kinematic viscosity.
 #[inline(always)]
 pub fn morris<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, nu: f64) -> Vector<D> {
-    let f = b.m * 4.0 * nu * ab.xij.dot(&ab.dwij) * ab.inv_r2_eps / (a.rho + b.rho);
+    let f = b.m * 4.0 * nu * ab.lap / (a.rho + b.rho);
     (a.u - b.u) * f
 }
 

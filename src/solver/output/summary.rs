@@ -46,7 +46,9 @@ pub struct Provenance {
 /// difference the passes compute, which changes the listing of pairs at exactly the
 /// support radius (W = 0 there, but the BQL mean pressure counts them). 4: a run stops as
 /// diverged at Mach 1 ([`BLOWUP_MACH`](crate::solver::simulation::BLOWUP_MACH)), not 10.
-pub const SCHEME_VERSION: &str = "4";
+/// 5: the Morris-form Laplacians (viscosity, EDAC pressure diffusion) take
+/// `x . grad W / (r^2 + 0.01 h^2)` from the list's kernel values (results change by rounding).
+pub const SCHEME_VERSION: &str = "5";
 
 /// Versions of parts of the solver that only some cases use, each bumped whenever that
 /// part's results change for unchanged parameters: `(parameter, value, version)`. A case

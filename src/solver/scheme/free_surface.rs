@@ -4,7 +4,7 @@
 use super::passes::KernelList;
 use super::{SurfacePressure, WallSet};
 use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal, smoothed_normal};
-use crate::solver::equations::{Pair, Point};
+use crate::solver::equations::Point;
 use crate::solver::math::Vector;
 use crate::solver::particles::Fluid;
 use crate::solver::LIGHT_LOOP_LEN;
@@ -49,14 +49,14 @@ impl<const D: usize> SurfaceFields<D> {
         // Eq. (42) and the summation density, over the fluid and the walls.
         self.n_star.par_iter_mut().zip(self.rho_sum.par_iter_mut()).enumerate().for_each(|(i, (ns, rs))| {
             let (mut nv, mut r) = (Vector::<D>::zeros(), 0.0);
-            nl.for_each(i, x, |j, xij, r2, &(w, g)| {
-                nv += normal(&fluid_point(fluid, j), &Pair::new(xij, r2, h, w, g));
-                r += fluid.m[j] * w;
+            nl.for_each(i, x, |j, xij, r2, kw| {
+                nv += normal(&fluid_point(fluid, j), &kw.pair(xij, r2, h));
+                r += fluid.m[j] * kw.w;
             });
             if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, xij, r2, &(w, g)| {
-                    nv += normal(&wall_point(ws, j), &Pair::new(xij, r2, h, w, g));
-                    r += ws.wall.m[j] * w;
+                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, xij, r2, kw| {
+                    nv += normal(&wall_point(ws, j), &kw.pair(xij, r2, h));
+                    r += ws.wall.m[j] * kw.w;
                 });
             }
             *ns = cut_normal(nv, h);
@@ -66,8 +66,8 @@ impl<const D: usize> SurfaceFields<D> {
         let n_star = &self.n_star;
         self.normal.par_iter_mut().enumerate().for_each(|(i, out)| {
             let mut nv = Vector::<D>::zeros();
-            nl.for_each(i, x, |j, xij, r2, &(w, g)| {
-                nv += smoothed_normal(&fluid_point(fluid, j), &n_star[j], &Pair::new(xij, r2, h, w, g));
+            nl.for_each(i, x, |j, xij, r2, kw| {
+                nv += smoothed_normal(&fluid_point(fluid, j), &n_star[j], &kw.pair(xij, r2, h));
             });
             let len = nv.norm();
             *out = if len > 0.0 { nv / len } else { Vector::zeros() };
@@ -86,12 +86,10 @@ impl<const D: usize> SurfaceFields<D> {
                 return;
             }
             let mut covered = false;
-            nl.for_each(i, x, |_, xij, r2, &(w, g)| {
-                covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g))
-            });
+            nl.for_each(i, x, |_, xij, r2, kw| covered |= in_normal_cone(&na, &kw.pair(xij, r2, h)));
             if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |_, xij, r2, &(w, g)| {
-                    covered |= in_normal_cone(&na, &Pair::new(xij, r2, h, w, g))
+                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |_, xij, r2, kw| {
+                    covered |= in_normal_cone(&na, &kw.pair(xij, r2, h))
                 });
             }
             *out = !covered;

@@ -11,7 +11,8 @@ use super::{
     WallSet,
 };
 use crate::solver::equations::{
-    artificial_viscosity, continuity, edac, free_surface, momentum, shifting, viscosity, Pair, Point,
+    artificial_viscosity, continuity, edac, free_surface, momentum, regularised_laplacian, shifting,
+    viscosity, Pair, Point,
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
@@ -23,9 +24,29 @@ use rayon::prelude::*;
 /// Particles per rayon task: large enough that scheduling is noise.
 const MIN_LEN: usize = 128;
 
-/// The neighbour list of a fluid body: each pair carries `(W_ab, (1/r) dW/dr)`, evaluated
-/// once per step when the list is built.
-pub type KernelList<const D: usize> = NeighbourList<D, (f64, f64)>;
+/// The neighbour list of a fluid body: each pair carries its [`PairKernel`], evaluated once
+/// per step when the list is built.
+pub type KernelList<const D: usize> = NeighbourList<D, PairKernel>;
+
+/// The kernel values of a listed pair, evaluated for all the pairs of a point in one
+/// vectorised loop (the passes then divide nothing for them).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PairKernel {
+    /// W_ab.
+    pub w: f64,
+    /// `(1/r) dW/dr`, which turns `x_ab` into `grad_a W_ab`.
+    pub grad_factor: f64,
+    /// `x_ab . grad W / (r^2 + 0.01 h^2)` ([`regularised_laplacian`]).
+    pub lap: f64,
+}
+
+impl PairKernel {
+    /// The pair at difference `xij` (`r2 = |xij|^2`) for smoothing length `h`.
+    #[inline(always)]
+    pub fn pair<const D: usize>(&self, xij: Vector<D>, r2: f64, h: f64) -> Pair<D> {
+        Pair::with_laplacian(xij, r2, h, self.w, self.grad_factor, self.lap)
+    }
+}
 
 /// Builds the neighbour list of `fluid` with the kernel values of each pair.
 pub fn build_kernel_list<const D: usize>(
@@ -35,7 +56,7 @@ pub fn build_kernel_list<const D: usize>(
     k: &Kernel,
 ) {
     let k = k.scaled(fluid.h);
-    nl.build(cells, &fluid.x, |r2, out| k.w_and_grad_factor_batch(r2, out));
+    nl.build(cells, &fluid.x, |r2, out| kernel_payload(&k, r2, out));
 }
 
 /// As [`build_kernel_list`], also summing each particle's density over the fluid,
@@ -53,9 +74,9 @@ pub fn build_kernel_list_summing_density<const D: usize>(
     nl.build_reducing(
         cells,
         &fluid.x,
-        |r2, out| k.w_and_grad_factor_batch(r2, out),
+        |r2, out| kernel_payload(&k, r2, out),
         rho,
-        |pairs| pairs.iter().fold(0.0, |s, (j, &(w, _))| s + m[j] * w),
+        |pairs| pairs.iter().fold(0.0, |s, (j, kw)| s + m[j] * kw.w),
     );
 }
 
@@ -70,12 +91,17 @@ pub fn build_kernel_list_cross<const D: usize>(
     k: &Kernel,
 ) {
     let k = k.scaled(h);
-    nl.build_cross(cells, sources, queries, |r2, out| k.w_and_grad_factor_batch(r2, out));
+    nl.build_cross(cells, sources, queries, |r2, out| kernel_payload(&k, r2, out));
 }
 
-#[inline(always)]
-fn cached_pair<const D: usize>(h: f64, xij: Vector<D>, r2: f64, &(w, f): &(f64, f64)) -> Pair<D> {
-    Pair::new(xij, r2, h, w, f)
+/// The [`PairKernel`]s of the pairs at squared distances `r2`.
+fn kernel_payload(k: &ScaledKernel, r2: &[f64], out: &mut [PairKernel]) {
+    let h = k.h;
+    k.w_and_grad_factor_map(r2, out, |r2, w, grad_factor| PairKernel {
+        w,
+        grad_factor,
+        lap: regularised_laplacian(grad_factor, r2, h),
+    });
 }
 
 #[inline(always)]
@@ -125,7 +151,7 @@ impl<const D: usize> Sources<'_, D> {
             #[inline(always)]
             |j, xij, r2, kw| {
                 let b = &self.pts[j];
-                f(&cached_pair(h, xij, r2, kw), b, b, true)
+                f(&kw.pair(xij, r2, h), b, b, true)
             },
         );
         if let Some((ws, div, visc)) = self.walls {
@@ -134,7 +160,7 @@ impl<const D: usize> Sources<'_, D> {
                 self.x[i],
                 &ws.wall.x,
                 #[inline(always)]
-                |j, xij, r2, kw| f(&cached_pair(h, xij, r2, kw), &div[j], &visc[j], false),
+                |j, xij, r2, kw| f(&kw.pair(xij, r2, h), &div[j], &visc[j], false),
             );
         }
     }
@@ -194,7 +220,7 @@ impl<const D: usize> FluidPasses<D> {
                 *rho = s;
                 if let Some(ws) = walls {
                     ws.fluid_to_wall
-                        .for_each_from(i, x[i], &ws.wall.x, |j, _, _, &(w, _)| *rho += ws.wall.m[j] * w);
+                        .for_each_from(i, x[i], &ws.wall.x, |j, _, _, kw| *rho += ws.wall.m[j] * kw.w);
                 }
             },
         );
@@ -606,10 +632,10 @@ pub fn ipst_chi_reference<const D: usize>(
     let chi: Vec<f64> = (0..fluid.len())
         .map(|i| {
             let mut s = 0.0;
-            let mut add = |_, _, kw: (f64, f64)| s += shifting::ipst_chi(fluid.h, kw.0);
-            nl.for_each(i, &fluid.x, |_, xij, r2, &kw| add(xij, r2, kw));
+            let mut add = |kw: &PairKernel| s += shifting::ipst_chi(fluid.h, kw.w);
+            nl.for_each(i, &fluid.x, |_, _, _, kw| add(kw));
             if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, xij, r2, &kw| add(xij, r2, kw));
+                ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, _, _, kw| add(kw));
             }
             s
         })
@@ -907,6 +933,27 @@ mod tests {
         (fluid, nl)
     }
 
+    /// The list's kernel values of every pair: W and `grad W` as the kernel gives them one
+    /// pair at a time (bit for bit), and the Laplacian factor equal to
+    /// `x_ab . grad W / (r^2 + 0.01 h^2)` computed from the gradient (to rounding).
+    #[test]
+    fn list_kernel_values_are_the_kernels() {
+        let (fluid, nl) = perturbed_lattice();
+        let k = Kernel::new(crate::solver::kernel::KernelKind::QuinticSpline, 2).scaled(fluid.h);
+        let mut pairs = 0;
+        for i in 0..fluid.len() {
+            nl.for_each(i, &fluid.x, |_, xij, r2, kw| {
+                let (w, f) = k.w_and_grad_factor(r2.sqrt());
+                assert_eq!((kw.w, kw.grad_factor), (w, f), "pair {i}: {xij:?}");
+                let dw = xij * f;
+                let lap = xij.dot(&dw) / (r2 + 0.01 * fluid.h * fluid.h);
+                assert!((kw.lap - lap).abs() <= 1e-14 * lap.abs().max(1e-300), "{} vs {lap}", kw.lap);
+                pairs += usize::from(r2 > 0.0);
+            });
+        }
+        assert!(pairs > 20 * fluid.len(), "{pairs} pairs");
+    }
+
     /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
     /// slabs, equals the direct sum of every particle over its whole neighbour list (to
     /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
@@ -969,8 +1016,8 @@ mod tests {
         for (i, a) in one.iter().enumerate() {
             // The term of eq. (37) over the whole list.
             let mut d = Vector::<2>::zeros();
-            nl.for_each(i, &fluid.x, |j, xij, r2, &(w, f)| {
-                d += shifting::ipst_displacement(fluid.m[j] / fluid.rho[j], &Pair::new(xij, r2, dx, w, f));
+            nl.for_each(i, &fluid.x, |j, xij, r2, kw| {
+                d += shifting::ipst_displacement(fluid.m[j] / fluid.rho[j], &kw.pair(xij, r2, dx));
             });
             // eq. (41) of one move of eq. (37)
             let direct = d * (u_max * dt) * (2.0 / (dt * dt));
