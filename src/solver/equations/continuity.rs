@@ -6,7 +6,7 @@ use super::{Pair, Point};
 /// shifting (u~ = u) this is the standard continuity equation.
 #[inline(always)]
 pub fn transport_divergence<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> f64 {
-    b.v() * a.rho * (a.u_hat - b.u_hat).dot(&ab.dwij)
+    b.v() * a.rho * (a.u_hat() - b.u_hat()).dot(&ab.dwij)
 }
 
 /// `+div(rho (u~ - u))`: the correction term of eq. (25). Printed with a `+` sign; the

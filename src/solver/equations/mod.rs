@@ -65,8 +65,8 @@ impl<const D: usize> Pair<D> {
 pub struct Point<const D: usize> {
     /// Momentum velocity u.
     pub u: Vector<D>,
-    /// Transport velocity u~ (equal to u without shifting).
-    pub u_hat: Vector<D>,
+    /// The shifting part of the transport velocity, `u~ - u` (zero without shifting).
+    pub du: Vector<D>,
     /// Mass.
     pub m: f64,
     /// Density.
@@ -75,6 +75,8 @@ pub struct Point<const D: usize> {
     pub p: f64,
     /// Volume m / rho.
     pub vol: f64,
+    /// 1 / rho,
+    pub inv_rho: f64,
     /// 1 / rho^2.
     pub inv_rho2: f64,
     /// 1 / m.
@@ -85,7 +87,18 @@ impl<const D: usize> Point<D> {
     /// A particle's view from its fields.
     #[inline(always)]
     pub fn new(u: Vector<D>, u_hat: Vector<D>, m: f64, rho: f64, p: f64) -> Self {
-        Self { u, u_hat, m, rho, p, vol: m / rho, inv_rho2: 1.0 / (rho * rho), inv_m: 1.0 / m }
+        let inv_rho = 1.0 / rho;
+        Self {
+            u,
+            du: u_hat - u,
+            m,
+            rho,
+            p,
+            vol: m / rho,
+            inv_rho,
+            inv_rho2: inv_rho * inv_rho,
+            inv_m: 1.0 / m,
+        }
     }
 
     /// Volume m / rho.
@@ -97,7 +110,13 @@ impl<const D: usize> Point<D> {
     /// u~ - u.
     #[inline(always)]
     pub fn du(&self) -> Vector<D> {
-        self.u_hat - self.u
+        self.du
+    }
+
+    /// The transport velocity u~.
+    #[inline(always)]
+    pub fn u_hat(&self) -> Vector<D> {
+        self.u + self.du
     }
 }
 

@@ -43,8 +43,8 @@ pub fn pressure_gradient_adami<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &
 /// `A = rho u (x) (u~ - u)`, so that `A . grad W = rho u ((u~ - u) . grad W)`.
 #[inline(always)]
 pub fn artificial_stress<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>) -> Vector<D> {
-    let aa = a.u * (a.du().dot(&ab.dwij) * a.rho * a.inv_rho2);
-    let bb = b.u * (b.du().dot(&ab.dwij) * b.rho * b.inv_rho2);
+    let aa = a.u * (a.du().dot(&ab.dwij) * a.inv_rho);
+    let bb = b.u * (b.du().dot(&ab.dwij) * b.inv_rho);
     (aa + bb) * b.m
 }
 

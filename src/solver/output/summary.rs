@@ -48,7 +48,9 @@ pub struct Provenance {
 /// diverged at Mach 1 ([`BLOWUP_MACH`](crate::solver::simulation::BLOWUP_MACH)), not 10.
 /// 5: the Morris-form Laplacians (viscosity, EDAC pressure diffusion) take
 /// `x . grad W / (r^2 + 0.01 h^2)` from the list's kernel values (results change by rounding).
-pub const SCHEME_VERSION: &str = "5";
+/// 6: a particle's record carries `u~ - u` and `1 / rho`, and the EDAC transport correction
+/// is evaluated in its reduced form `V_b (p_b - p_a) du_b . grad W` (rounding again).
+pub const SCHEME_VERSION: &str = "6";
 
 /// Versions of parts of the solver that only some cases use, each bumped whenever that
 /// part's results change for unchanged parameters: `(parameter, value, version)`. A case
