@@ -145,14 +145,13 @@ impl<const D: usize> Sources<'_, D> {
     #[inline(always)]
     fn for_each(&self, i: usize, mut f: impl FnMut(&Pair<D>, &Point<D>, &Point<D>, bool)) {
         let h = self.h;
-        self.nl.for_each(
+        self.nl.for_each_with(
             i,
+            self.x[i],
             self.x,
+            self.pts,
             #[inline(always)]
-            |j, xij, r2, kw| {
-                let b = &self.pts[j];
-                f(&kw.pair(xij, r2, h), b, b, true)
-            },
+            |_, xij, r2, kw, b| f(&kw.pair(xij, r2, h), b, b, true),
         );
         if let Some((ws, div, visc)) = self.walls {
             ws.fluid_to_wall.for_each_from(
