@@ -356,17 +356,12 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         points: &[Vector<D>],
         mut f: F,
     ) {
-        let (chunk, range) = self.range(i);
-        let shifts = self.shift_table();
-        for (&e, p) in chunk.entries[range.clone()].iter().zip(&chunk.payload[range]) {
-            let (j, xij) = Self::pair(shifts, e, xi, points);
-            f(j, xij, xij.norm_squared(), p);
-        }
+        self.for_each_with(i, xi, points, points, |j, xij, r2, p, _| f(j, xij, r2, p));
     }
 
     /// As [`for_each_from`](Self::for_each_from), also handing `f` each neighbour's record
-    /// `records[j]`: the passes' loop, which reads a neighbour's position and record with
-    /// one bounds check a call instead of two a pair.
+    /// `records[j]`: the loop of every pass, which reads a neighbour's position and record
+    /// with one bounds check a call instead of two a pair.
     #[inline(always)]
     pub fn for_each_with<T, F: FnMut(usize, Vector<D>, f64, &P, &T)>(
         &self,
