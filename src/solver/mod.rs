@@ -4,6 +4,7 @@
 //! - [`particles`]: per-body storage; [`equations`]: one function per physics term;
 //! - [`scheme`]: named compositions of the terms and the passes that run them;
 //! - [`integrator`]: kick-drift-kick and the time step; [`simulation`]: the run loop;
+//!   [`warm`]: the pool's workers kept awake while a run steps;
 //! - [`output`]: ParaView snapshots, time series and the run summary.
 
 /// `NAMES` (the accepted names, in order) and `from_name` for an enum of choices, each
@@ -34,6 +35,7 @@ pub mod output;
 pub mod particles;
 pub mod scheme;
 pub mod simulation;
+pub mod warm;
 
 /// Particles per rayon task in the loops that do a few flops per particle (kicks, drift,
 /// wrapping, checks, explicit updates): tasks must be long for the scheduling not to

@@ -9,7 +9,7 @@ use crate::solver::scheme::{
     build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, DensityModel, FluidPasses,
     FluidScheme, KernelList, PressureModel, Shifting, SurfaceFields, SurfacePressure, WallSet,
 };
-use crate::solver::LIGHT_LOOP_LEN;
+use crate::solver::{warm, LIGHT_LOOP_LEN};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -422,7 +422,7 @@ impl<const D: usize> Simulation<D> {
         mut on_step: impl FnMut(&Self) -> bool,
     ) -> Result<bool, Divergence> {
         let eps = 1e-12 * t_end.abs().max(1.0);
-        loop {
+        warm::keep_warm(|| loop {
             let remaining = t_end - self.state.time;
             if self.state.time >= t_stop - eps || remaining <= eps {
                 return Ok(true);
@@ -431,7 +431,7 @@ impl<const D: usize> Simulation<D> {
             if !on_step(self) {
                 return Ok(false);
             }
-        }
+        })
     }
 
     /// Largest particle speed.
