@@ -89,7 +89,13 @@ pub struct BenchResult {
     pub nx: usize,
     /// Rayon threads.
     pub threads: usize,
-    /// Particle count.
+    /// Simulations stepped at once, each on its own pool of `threads` threads, with their
+    /// throughputs summed (`bench --interleave`): k copies on one thread each give what the
+    /// host lets k independent runs do together, the ceiling of a k-thread speed-up on a
+    /// machine whose cores slow each other down (shared caches, memory, a hypervisor).
+    #[serde(default = "one_copy")]
+    pub copies: usize,
+    /// Particle count (of one copy).
     pub particles: usize,
     /// Timed steps (after warm-up).
     pub steps: u64,
@@ -112,6 +118,21 @@ pub struct BenchResult {
     pub runs: Vec<f64>,
 }
 
+fn one_copy() -> usize {
+    1
+}
+
+impl BenchResult {
+    /// The thread count as the table gives it: `k x 1` for k copies on one thread each.
+    pub fn threads_label(&self) -> String {
+        if self.copies > 1 {
+            format!("{} x {}", self.copies, self.threads)
+        } else {
+            self.threads.to_string()
+        }
+    }
+}
+
 /// A timed run that may be repeated: what makes two runs the same configuration, its
 /// throughput, and where the throughputs of all its runs go.
 pub trait Repeated: Clone {
@@ -128,9 +149,9 @@ pub trait Repeated: Clone {
 }
 
 impl Repeated for BenchResult {
-    type Key = (String, String, usize, usize);
+    type Key = (String, String, usize, usize, usize);
     fn key(&self) -> Self::Key {
-        (self.variant.clone(), self.kernel.clone(), self.nx, self.threads)
+        (self.variant.clone(), self.kernel.clone(), self.nx, self.threads, self.copies)
     }
     fn speed(&self) -> f64 {
         self.particle_steps_per_second
@@ -265,12 +286,54 @@ impl Timed {
         Ok(())
     }
 
+    /// Times `steps` steps of every simulation of `sims` at once, each on its own pool of
+    /// `pools` (after one untimed step each, and a barrier, so that they start together),
+    /// adding them up as one block of their summed steps over the slowest one's seconds.
+    /// The phase times are the first simulation's.
+    fn concurrent_steps(
+        &mut self,
+        sims: &mut [&mut Simulation<2>],
+        pools: &[rayon::ThreadPool],
+        steps: u64,
+    ) -> Result<(), String> {
+        let barrier = std::sync::Barrier::new(sims.len());
+        let each: Vec<Result<Timed, String>> = std::thread::scope(|s| {
+            let handles: Vec<_> = sims
+                .iter_mut()
+                .zip(pools)
+                .map(|(sim, pool)| {
+                    let barrier = &barrier;
+                    s.spawn(move || {
+                        pool.install(|| {
+                            sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+                            barrier.wait();
+                            let mut timed = Timed::default();
+                            timed.steps(sim, steps)?;
+                            Ok(timed)
+                        })
+                    })
+                })
+                .collect();
+            handles.into_iter().map(|h| h.join().unwrap_or_else(|_| Err("a copy panicked".into()))).collect()
+        });
+        let each = each.into_iter().collect::<Result<Vec<_>, _>>()?;
+        let seconds = each.iter().map(|t| t.seconds).fold(0.0, f64::max);
+        let all_steps = steps * each.len() as u64;
+        self.seconds += seconds;
+        self.steps += all_steps;
+        self.ipst += each.iter().map(|t| t.ipst).sum::<usize>();
+        self.times += each[0].times.scaled(seconds / each[0].seconds);
+        self.runs.push(sims[0].fluid().len() as f64 * all_steps as f64 / seconds);
+        Ok(())
+    }
+
     fn result(self, variant: &str, kernel: &str, nx: usize, threads: usize, particles: usize) -> BenchResult {
         BenchResult {
             variant: variant.into(),
             kernel: kernel.into(),
             nx,
             threads,
+            copies: 1,
             particles,
             steps: self.steps,
             seconds: self.seconds,
@@ -314,7 +377,10 @@ pub fn run_case(
 /// reversed every other round. A slow spell of a noisy machine, even one of seconds, then
 /// falls on every configuration alike, and each block's throughput is a run (`runs`), so
 /// that every ratio is the median of the rounds' own ratios. A variant's thread counts step
-/// the same simulation, whose results do not depend on the thread count. Memory: the
+/// the same simulation, whose results do not depend on the thread count. When one thread is
+/// among `threads`, every larger count k also gets a configuration of k copies of the
+/// simulation stepped at once on one thread each (`copies`): the speed-up the host allows
+/// independent runs, against which the k-thread speed-up is read. Memory: the
 /// resident growth while a simulation was built and warmed (`bytes_per_particle`), and the
 /// process's peak with all of them (`peak_rss_bytes`).
 pub fn run_interleaved(
@@ -326,21 +392,39 @@ pub fn run_interleaved(
     warmup: u64,
     kernel: &str,
 ) -> Result<Vec<BenchResult>, String> {
-    let pools = threads
-        .iter()
-        .map(|&t| rayon::ThreadPoolBuilder::new().num_threads(t).build())
-        .collect::<Result<Vec<_>, _>>()
-        .map_err(|e| format!("cannot start a thread pool: {e}"))?;
+    let pool = |t: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(t)
+            .build()
+            .map_err(|e| format!("cannot start a thread pool: {e}"))
+    };
+    let pools = threads.iter().map(|&t| pool(t)).collect::<Result<Vec<_>, _>>()?;
     let widest = pools.iter().max_by_key(|p| p.current_num_threads()).ok_or("no thread count")?;
+    let copy_counts: Vec<usize> =
+        if threads.contains(&1) { threads.iter().copied().filter(|&t| t > 1).collect() } else { Vec::new() };
+    let most_copies = copy_counts.iter().copied().max().unwrap_or(1);
+    let solo = (0..most_copies).map(|_| pool(1)).collect::<Result<Vec<_>, _>>()?;
+    // Each variant's simulation and the further copies of it, with the resident growth of
+    // building the first.
     let mut sims = Vec::new();
     for v in variants {
         let rss0 = status_kb("VmRSS:") * 1024;
         let sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
-        sims.push((sim, (status_kb("VmRSS:") * 1024).saturating_sub(rss0)));
+        let grown = (status_kb("VmRSS:") * 1024).saturating_sub(rss0);
+        let copies = (1..most_copies)
+            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup)))
+            .collect::<Result<Vec<_>, _>>()?;
+        sims.push((sim, copies, grown));
     }
     let block = steps.div_ceil(rounds as u64).max(1);
-    let configs: Vec<(usize, usize)> =
-        (0..sims.len()).flat_map(|v| (0..pools.len()).map(move |t| (v, t))).collect();
+    // (variant, pool, copies): the thread counts on their pools, then the copies (each on a
+    // pool of `solo`; their pool index is unused).
+    let configs: Vec<(usize, usize, usize)> = (0..sims.len())
+        .flat_map(|v| {
+            let on_pools = (0..pools.len()).map(move |t| (v, t, 1));
+            on_pools.chain(copy_counts.iter().map(move |&k| (v, 0, k)))
+        })
+        .collect();
     let mut timed: Vec<Timed> = configs.iter().map(|_| Timed::default()).collect();
     for round in 0..rounds {
         let mut order: Vec<usize> = (0..configs.len()).collect();
@@ -348,25 +432,32 @@ pub fn run_interleaved(
             order.reverse();
         }
         for c in order {
-            let (v, t) = configs[c];
-            let sim = &mut sims[v].0;
-            pools[t].install(|| -> Result<(), String> {
-                sim.step(f64::INFINITY).map_err(|d| d.reason)?;
-                timed[c].steps(sim, block)
-            })?;
+            let (v, t, copies) = configs[c];
+            let (sim, more, _) = &mut sims[v];
+            if copies > 1 {
+                let mut all: Vec<&mut Simulation<2>> = std::iter::once(sim).chain(more.iter_mut()).collect();
+                timed[c].concurrent_steps(&mut all[..copies], &solo[..copies], block)?;
+            } else {
+                pools[t].install(|| -> Result<(), String> {
+                    sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+                    timed[c].steps(sim, block)
+                })?;
+            }
         }
     }
     let hwm = status_kb("VmHWM:") * 1024;
     Ok(configs
         .iter()
         .zip(timed)
-        .map(|(&(v, t), timed)| {
-            let (sim, grown) = &sims[v];
+        .map(|(&(v, t, copies), timed)| {
+            let (sim, _, grown) = &sims[v];
             let n = sim.fluid().len();
+            let threads = if copies > 1 { 1 } else { threads[t] };
             BenchResult {
                 peak_rss_bytes: hwm,
                 bytes_per_particle: *grown as f64 / n as f64,
-                ..timed.result(&variants[v], kernel, nx, threads[t], n)
+                copies,
+                ..timed.result(&variants[v], kernel, nx, threads, n)
             }
         })
         .collect())
@@ -442,7 +533,7 @@ pub fn median_interval(sorted: &[f64]) -> Option<(f64, f64)> {
 /// the peer's end time. Ratios of repeated runs are those of each round (see [`ratio`]).
 pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
-        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up 2 vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
+        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
     );
     if !peers.is_empty() {
         s.push_str(&format!(
@@ -455,15 +546,23 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     }
     s.push('\n');
     for r in results {
-        let edac = results.iter().find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads);
-        let one = results.iter().find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1);
+        let edac = results
+            .iter()
+            .find(|e| e.variant == "edac" && e.nx == r.nx && e.threads == r.threads && e.copies == r.copies);
+        let one = results
+            .iter()
+            .find(|e| e.variant == r.variant && e.nx == r.nx && e.threads == 1 && e.copies == 1);
         let cost = match edac {
             Some(e) if std::ptr::eq(e, r) => "1.00".to_string(),
             Some(e) => ratio(e, r, 2, ""),
             None => String::new(),
         };
-        let speedup =
-            if r.threads > 1 { one.map(|o| ratio(r, o, 2, "")).unwrap_or_default() } else { String::new() };
+        // Of k copies on one thread each, the speed-up the host allows k independent runs.
+        let speedup = if r.threads * r.copies > 1 {
+            one.map(|o| ratio(r, o, 2, "")).unwrap_or_default()
+        } else {
+            String::new()
+        };
         let p = &r.phase_shares;
         let shares = format!(
             "{:.0}/{:.0}/{:.0}/{:.0}/{:.0}/{:.0}",
@@ -480,7 +579,7 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             r.variant,
             r.nx,
             r.particles,
-            r.threads,
+            r.threads_label(),
             r.steps,
             speed,
             1e9 / r.particle_steps_per_second,
@@ -491,7 +590,7 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             shares
         ));
         if !peers.is_empty() {
-            match peers.iter().find(|p| p.nx == r.nx && p.threads == r.threads) {
+            match peers.iter().find(|p| p.nx == r.nx && p.threads == r.threads && r.copies == 1) {
                 Some(p) => {
                     let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.2}", 100.0 * v));
                     let l1 = if r.variant == "edac" {
@@ -521,6 +620,13 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             }
         }
     }
+    for k in results.iter().map(|r| r.copies).filter(|&k| k > 1).collect::<std::collections::BTreeSet<_>>() {
+        s.push_str(&format!(
+            "\n`{k} x 1`: {k} copies of the case stepped at once, on one thread each, their throughputs \
+             summed: their speed-up is what this host gives {k} independent runs, the ceiling of \
+             the {k}-thread one.\n"
+        ));
+    }
     s
 }
 
@@ -535,6 +641,7 @@ mod peer_tests {
             kernel: DEFAULT_KERNEL.into(),
             nx,
             threads,
+            copies: 1,
             particles: nx * nx,
             steps: 100,
             seconds: 1.0,
@@ -641,16 +748,26 @@ mod peer_tests {
         assert_eq!(ratio(&a, &b, 1, "x"), "3.0x (2.0-4.0)");
     }
 
-    /// Side by side: one result per variant and thread count, in the order of the table,
-    /// with one run per round and the block's steps added up; IPST at its cap.
+    /// Side by side: one result per variant and thread count, then the variant's two
+    /// copies on one thread each (twice the steps in the same blocks), in the order of the
+    /// table, with one run per round and the block's steps added up; IPST at its cap.
     #[test]
     fn interleaved_cases_report_one_run_a_round() {
         let variants = ["edac".to_string(), "ctvf+ipst".to_string()];
         let r = run_interleaved(&variants, 12, &[1, 2], 5, 2, 1, DEFAULT_KERNEL).unwrap();
-        let got: Vec<_> = r.iter().map(|r| (r.variant.as_str(), r.threads, r.steps, r.runs.len())).collect();
+        let got: Vec<_> =
+            r.iter().map(|r| (r.variant.as_str(), r.threads_label(), r.steps, r.runs.len())).collect();
+        let row = |v, t: &str, steps| (v, t.to_string(), steps, 2);
         assert_eq!(
             got,
-            [("edac", 1, 6, 2), ("edac", 2, 6, 2), ("ctvf+ipst", 1, 6, 2), ("ctvf+ipst", 2, 6, 2)]
+            [
+                row("edac", "1", 6),
+                row("edac", "2", 6),
+                row("edac", "2 x 1", 12),
+                row("ctvf+ipst", "1", 6),
+                row("ctvf+ipst", "2", 6),
+                row("ctvf+ipst", "2 x 1", 12)
+            ]
         );
         for r in &r {
             assert_eq!(r.particles, 144);
@@ -659,8 +776,23 @@ mod peer_tests {
             let hm = r.runs.len() as f64 / r.runs.iter().map(|s| 1.0 / s).sum::<f64>();
             assert!((hm / r.particle_steps_per_second - 1.0).abs() < 1e-9, "{r:?}");
         }
-        assert_eq!((r[0].ipst_iterations_mean, r[2].ipst_iterations_mean), (0.0, 10.0));
+        assert_eq!(
+            (r[0].ipst_iterations_mean, r[3].ipst_iterations_mean, r[5].ipst_iterations_mean),
+            (0.0, 10.0, 10.0)
+        );
+        // Without one thread among the counts there is no speed-up to bound: no copies.
+        let two = run_interleaved(&variants[..1], 12, &[2], 2, 2, 0, DEFAULT_KERNEL).unwrap();
+        assert_eq!(two.iter().map(|r| r.copies).collect::<Vec<_>>(), [1]);
         assert!(run_interleaved(&["sph".to_string()], 12, &[1], 2, 2, 0, DEFAULT_KERNEL).is_err());
+    }
+
+    /// A result written before copies were timed reads back as one copy.
+    #[test]
+    fn results_without_copies_read_as_one() {
+        let mut v = serde_json::to_value(sample("edac", 50, 2, 1.0e6)).unwrap();
+        v.as_object_mut().unwrap().remove("copies");
+        let r: BenchResult = serde_json::from_value(v).unwrap();
+        assert_eq!((r.copies, r.threads_label()), (1, "2".to_string()));
     }
 
     /// The interval of the median from order statistics: the extremes at six samples

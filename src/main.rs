@@ -601,7 +601,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
                             format!(
                                 "{} on {}: {:.3} M",
                                 r.variant,
-                                r.threads,
+                                r.threads_label(),
                                 r.particle_steps_per_second / 1e6
                             )
                         })

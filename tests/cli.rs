@@ -352,11 +352,26 @@ fn bench_interleaves_the_cases_of_a_size() {
             (
                 r["variant"].as_str().unwrap(),
                 r["threads"].as_u64().unwrap(),
+                r["copies"].as_u64().unwrap(),
                 r["runs"].as_array().unwrap().len(),
             )
         })
         .collect();
-    assert_eq!(rows, [("edac", 1, 3), ("edac", 2, 3), ("ctvf+sun", 1, 3), ("ctvf+sun", 2, 3)]);
+    // Each variant on one and two threads, then two copies on one thread each.
+    assert_eq!(
+        rows,
+        [
+            ("edac", 1, 1, 3),
+            ("edac", 2, 1, 3),
+            ("edac", 1, 2, 3),
+            ("ctvf+sun", 1, 1, 3),
+            ("ctvf+sun", 2, 1, 3),
+            ("ctvf+sun", 1, 2, 3)
+        ]
+    );
+    // Two copies did twice the steps of one in the same rounds.
+    let steps = |i: usize| v["results"][i]["steps"].as_u64().unwrap();
+    assert_eq!(steps(2), 2 * steps(0));
     // One shape with or without a peer: the provenance of the sitting (the build, and the
     // machine, named in the title too).
     let (build, host) = (&v["provenance"], &v["provenance"]["machine"]);
@@ -370,6 +385,10 @@ fn bench_interleaves_the_cases_of_a_size() {
     // The cost of ctvf+sun and the speed-up with their ranges over the rounds.
     let sun = table.lines().find(|l| l.starts_with("| ctvf+sun | 16 | 256 | 2 |")).unwrap();
     assert_eq!(sun.matches(") |").count(), 3, "{sun}");
+    // The copies' row has its own speed-up against one thread, and the table says what it is.
+    let pair = table.lines().find(|l| l.starts_with("| ctvf+sun | 16 | 256 | 2 x 1 |")).unwrap();
+    assert_eq!(pair.matches(") |").count(), 3, "{pair}");
+    assert!(table.contains("`2 x 1`: 2 copies"), "{table}");
     for bad in [
         &["--interleave", "3", "--repeat", "2"][..],
         &["--interleave", "1"],
