@@ -305,8 +305,10 @@ impl Timed {
                     let barrier = &barrier;
                     s.spawn(move || {
                         pool.install(|| {
-                            sim.step(f64::INFINITY).map_err(|d| d.reason)?;
+                            let first = sim.step(f64::INFINITY).map_err(|d| d.reason);
+                            // Every copy reaches the barrier, even one whose step failed.
                             barrier.wait();
+                            first?;
                             let mut timed = Timed::default();
                             timed.steps(sim, steps)?;
                             Ok(timed)
