@@ -419,12 +419,11 @@ pub fn run_interleaved(
         sims.push((sim, copies, grown));
     }
     let block = steps.div_ceil(rounds as u64).max(1);
-    // (variant, pool, copies): the thread counts on their pools, then the copies (each on a
-    // pool of `solo`; their pool index is unused).
-    let configs: Vec<(usize, usize, usize)> = (0..sims.len())
+    // Each variant on the pool of every thread count, then as its copies.
+    let configs: Vec<(usize, On)> = (0..sims.len())
         .flat_map(|v| {
-            let on_pools = (0..pools.len()).map(move |t| (v, t, 1));
-            on_pools.chain(copy_counts.iter().map(move |&k| (v, 0, k)))
+            let on_pools = (0..pools.len()).map(move |t| (v, On::Pool(t)));
+            on_pools.chain(copy_counts.iter().map(move |&k| (v, On::Copies(k))))
         })
         .collect();
     let mut timed: Vec<Timed> = configs.iter().map(|_| Timed::default()).collect();
@@ -434,16 +433,18 @@ pub fn run_interleaved(
             order.reverse();
         }
         for c in order {
-            let (v, t, copies) = configs[c];
+            let (v, on) = configs[c];
             let (sim, more, _) = &mut sims[v];
-            if copies > 1 {
-                let mut all: Vec<&mut Simulation<2>> = std::iter::once(sim).chain(more.iter_mut()).collect();
-                timed[c].concurrent_steps(&mut all[..copies], &solo[..copies], block)?;
-            } else {
-                pools[t].install(|| -> Result<(), String> {
+            match on {
+                On::Pool(t) => pools[t].install(|| -> Result<(), String> {
                     sim.step(f64::INFINITY).map_err(|d| d.reason)?;
                     timed[c].steps(sim, block)
-                })?;
+                })?,
+                On::Copies(k) => {
+                    let mut all: Vec<&mut Simulation<2>> =
+                        std::iter::once(sim).chain(more.iter_mut()).collect();
+                    timed[c].concurrent_steps(&mut all[..k], &solo[..k], block)?;
+                }
             }
         }
     }
@@ -451,10 +452,13 @@ pub fn run_interleaved(
     Ok(configs
         .iter()
         .zip(timed)
-        .map(|(&(v, t, copies), timed)| {
+        .map(|(&(v, on), timed)| {
             let (sim, _, grown) = &sims[v];
             let n = sim.fluid().len();
-            let threads = if copies > 1 { 1 } else { threads[t] };
+            let (threads, copies) = match on {
+                On::Pool(t) => (threads[t], 1),
+                On::Copies(k) => (1, k),
+            };
             BenchResult {
                 peak_rss_bytes: hwm,
                 bytes_per_particle: *grown as f64 / n as f64,
@@ -463,6 +467,14 @@ pub fn run_interleaved(
             }
         })
         .collect())
+}
+
+/// Where an interleaved configuration runs: on the pool of `threads[t]`, or as k copies
+/// stepped at once on one-thread pools.
+#[derive(Clone, Copy)]
+enum On {
+    Pool(usize),
+    Copies(usize),
 }
 
 /// Steps to time for `n` particles: about 4 million particle-steps, at least 20 steps.
