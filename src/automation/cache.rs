@@ -316,7 +316,7 @@ mod tests {
             CaseRecord::new("p", &c).solver
         };
         assert_eq!(with("none"), fingerprint_of("taylor_green"));
-        for (pst, version) in [("sun", "+sun1"), ("ipst", "+ipst2")] {
+        for (pst, version) in [("sun", "+sun1"), ("ipst", "+ipst3")] {
             assert!(with(pst).starts_with(&fingerprint_of("taylor_green")) && with(pst).ends_with(version));
         }
     }

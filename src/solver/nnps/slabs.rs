@@ -14,8 +14,7 @@
 use super::CellList;
 use std::ops::Range;
 
-/// Slabs of whole cell layers of one body, each with at least a given number of points
-/// (the last may have fewer).
+/// Slabs of whole cell layers of one body, each with at least a given number of layers.
 #[derive(Clone, Debug, Default)]
 pub struct Slabs {
     /// Slab `s` holds the points `bounds[s]..bounds[s + 1]`.
@@ -29,23 +28,24 @@ impl Slabs {
     }
 
     /// Partitions the points binned by `cells` (in cell order: after
-    /// [`CellList::mark_reordered`]) into slabs of whole layers, closing a slab as soon as
-    /// it holds at least `min_points` in at least `min_layers` layers.
+    /// [`CellList::mark_reordered`]) into slabs of whole layers, the layers shared out
+    /// evenly: as many slabs as keeps at least `min_layers` layers and, on average,
+    /// `min_points` points in each, rounded down to a power of two (at least one slab).
+    /// Equal slabs in a power-of-two number halve into equal work for any power-of-two
+    /// number of threads, and the fewer the slabs, the fewer the pairs between them.
     pub fn partition<const D: usize>(&mut self, cells: &CellList<D>, min_points: usize, min_layers: usize) {
         debug_assert!(
             cells.order().iter().enumerate().all(|(k, &i)| k == i as usize),
             "slabs need the points in cell order"
         );
+        let layers = cells.layers();
+        let points = cells.layer_points(0..layers).len();
+        let most = (layers / min_layers.max(1)).min(points / min_points.max(1)).max(1);
+        let slabs = 1 << most.ilog2();
         self.bounds.clear();
         self.bounds.push(0);
-        let mut first = 0;
-        for layer in 0..cells.layers() {
-            let points = cells.layer_points(first..layer + 1);
-            let full = points.len() >= min_points.max(1) && layer + 1 - first >= min_layers;
-            if full || layer + 1 == cells.layers() {
-                self.bounds.push(points.end);
-                first = layer + 1;
-            }
+        for s in 1..=slabs {
+            self.bounds.push(cells.layer_points(0..s * layers / slabs).end);
         }
     }
 
@@ -163,23 +163,34 @@ mod tests {
     }
 
     #[test]
-    fn slabs_tile_the_points_in_whole_layers() {
+    fn slabs_tile_the_points_in_whole_layers_shared_out_evenly() {
         let (cells, x) = sorted_lattice(40, 0.08);
-        let mut slabs = Slabs::new();
-        slabs.partition(&cells, 300, 1);
-        assert!(slabs.len() >= 3, "{} slabs", slabs.len());
-        assert_eq!(slabs.range(0).start, 0);
-        assert_eq!(slabs.range(slabs.len() - 1).end, x.len());
-        for s in 0..slabs.len() {
-            let r = slabs.range(s);
-            if s + 1 < slabs.len() {
-                assert!(r.len() >= 300);
-                assert_eq!(r.end, slabs.range(s + 1).start);
-            }
-            // Whole layers: the first point of a slab starts a layer.
-            let layer = |i: usize| cells.cell_of(i) / 12; // 1 / 0.08 -> 12 cells a row
-            if r.start > 0 {
-                assert_ne!(layer(r.start), layer(r.start - 1));
+        assert_eq!(cells.layers(), 12, "1 / 0.08 -> 12 cells a row");
+        let layer = |i: usize| cells.cell_of(i) / 12;
+        // (min points, min layers) -> slabs, rounded down to a power of two: 1600 points /
+        // 300 -> 5 -> 4; 12 layers / 6 -> 2; 12 layers / 1 -> 12 -> 8; too many points
+        // asked for -> one slab.
+        for ((min_points, min_layers), want) in [((300, 1), 4), ((1, 6), 2), ((1, 1), 8), ((10_000, 1), 1)] {
+            let mut slabs = Slabs::new();
+            slabs.partition(&cells, min_points, min_layers);
+            assert_eq!(slabs.len(), want, "min {min_points} points, {min_layers} layers");
+            assert_eq!(slabs.range(0).start, 0);
+            assert_eq!(slabs.range(slabs.len() - 1).end, x.len());
+            for s in 0..slabs.len() {
+                let r = slabs.range(s);
+                if s + 1 < slabs.len() {
+                    assert_eq!(r.end, slabs.range(s + 1).start);
+                }
+                // Whole layers (a slab starts a layer), as many as the even share:
+                // 12 layers into 8 slabs -> 1 or 2 each.
+                if r.start > 0 {
+                    assert_ne!(layer(r.start), layer(r.start - 1));
+                }
+                let spanned = layer(r.end - 1) - layer(r.start) + 1;
+                assert!(
+                    (12 / want..=12_usize.div_ceil(want)).contains(&spanned),
+                    "slab {s}: {spanned} layers"
+                );
             }
         }
     }
@@ -188,10 +199,10 @@ mod tests {
     /// its own slab, or in a slab that names the point's slab among its spill sources.
     #[test]
     fn neighbours_after_a_point_lie_in_its_slab_or_one_that_takes_its_spills() {
-        for min_points in [1, 150, 400, 10_000] {
+        for (min_points, min_layers) in [(1, 1), (1, 2), (150, 2), (400, 2), (10_000, 2)] {
             let (cells, x) = sorted_lattice(40, 0.08);
             let mut slabs = Slabs::new();
-            slabs.partition(&cells, min_points, 2);
+            slabs.partition(&cells, min_points, min_layers);
             let slab_of = |i: usize| (0..slabs.len()).find(|&s| slabs.range(s).contains(&i)).unwrap();
             let mut nl = NeighbourList::<2, ()>::new();
             nl.build(&cells, &x, |_, _| {});

@@ -58,11 +58,13 @@ pub const SCHEME_VERSION: &str = "6";
 /// its results. `pst = ipst`, 1: each fluid pair is evaluated once a sweep and added to
 /// both particles (results change by rounding). `pst = sun` 1 and `ipst` 2: a step shorter
 /// than the one the shifting was evaluated for (the last before an end time; adaptive steps)
-/// keeps its shifting velocity. `surface_pressure` other than `evolve`, 1: the walls'
+/// keeps its shifting velocity. `ipst` 3: the sweeps' slabs share the layers out evenly,
+/// eight layers at least, in a power-of-two number (the sums change by rounding).
+/// `surface_pressure` other than `evolve`, 1: the walls'
 /// pressure is extrapolated from the surface pressures as set, not as evolved.
 pub const PART_VERSIONS: &[(&str, &str, u32)] = &[
     ("pst", "sun", 1),
-    ("pst", "ipst", 2),
+    ("pst", "ipst", 3),
     ("surface_pressure", "zero", 1),
     ("surface_pressure", "zero_isolated", 1),
     ("surface_pressure", "non_negative", 1),

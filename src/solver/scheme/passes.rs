@@ -461,17 +461,20 @@ impl<const D: usize> FluidPasses<D> {
     }
 }
 
-/// Fewest particles in an IPST slab: enough that the shares set aside at its edge are a
-/// small part of its pairs and a task is long against rayon's scheduling; few enough that
-/// the two threads have several slabs at nx = 50. Fixed, so that the slabs, and with them
-/// the sums, do not depend on the thread count.
+/// Fewest particles in an IPST slab on average: enough that a task is long against rayon's
+/// scheduling. Fixed, as [`IPST_SLAB_LAYERS`], so that the slabs, and with them the sums, do
+/// not depend on the thread count.
 const IPST_SLAB: usize = 1024;
 /// Fewest cell layers in an IPST slab: the pairs between a slab's last layer and the next
-/// slab's first are set aside, so thin slabs set aside most of theirs.
-const IPST_SLAB_LAYERS: usize = 4;
+/// slab's first are set aside and added in a second loop, at about twice the cost of a pair
+/// within the slab, so thin slabs cost more. Eight rather than four took 4-7 % off a sweep
+/// on one thread and about 10 % on two at nx = 100 (session 28, samples in the sweeps
+/// against the rest of the step), and still gives two slabs at nx = 50.
+const IPST_SLAB_LAYERS: usize = 8;
 /// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
-/// cache level, and the vectorised loops run over the group's pairs, padded once.
-const IPST_GROUP: usize = 8;
+/// cache level, and the vectorised loops run over the group's pairs, padded once. Sixteen
+/// rather than eight: 3-7 % off a sweep on one thread (fewer padded lanes and loop ends).
+const IPST_GROUP: usize = 16;
 /// Vector lanes the pair arrays are padded to.
 const LANES: usize = 8;
 
@@ -962,7 +965,7 @@ mod tests {
         use crate::solver::kernel::KernelKind;
         use crate::solver::nnps::Domain;
         use crate::solver::particles::FluidInit;
-        let (n, dx) = (64, 1.0 / 64.0);
+        let (n, dx) = (128, 1.0 / 128.0);
         let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
         let x: Vec<Vector<2>> = (0..n * n)
             .map(|k| {
