@@ -14,7 +14,8 @@
 use super::CellList;
 use std::ops::Range;
 
-/// Slabs of whole cell layers of one body, each with at least a given number of layers.
+/// Slabs of whole cell layers of one body, each with at least a given number of layers
+/// (or a single slab of all of them, when there are fewer).
 #[derive(Clone, Debug, Default)]
 pub struct Slabs {
     /// Slab `s` holds the points `bounds[s]..bounds[s + 1]`.

@@ -60,8 +60,8 @@ pub const SCHEME_VERSION: &str = "6";
 /// than the one the shifting was evaluated for (the last before an end time; adaptive steps)
 /// keeps its shifting velocity. `ipst` 3: the sweeps' slabs share the layers out evenly,
 /// eight layers at least, in a power-of-two number (the sums change by rounding).
-/// `surface_pressure` other than `evolve`, 1: the walls'
-/// pressure is extrapolated from the surface pressures as set, not as evolved.
+/// `surface_pressure` other than `evolve`, 1: the walls' pressure is extrapolated from the
+/// surface pressures as set, not as evolved.
 pub const PART_VERSIONS: &[(&str, &str, u32)] = &[
     ("pst", "sun", 1),
     ("pst", "ipst", 3),
