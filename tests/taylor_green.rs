@@ -1,6 +1,6 @@
-//! Taylor-Green vortex (CTVF sec. 4.1): error bounds at a small size, the effect of the
-//! correction terms at Re = 1000 (figs. 10-11), convergence with resolution (figs. 8-9),
-//! thread-count independence and bit-for-bit restart.
+//! Taylor-Green vortex (CTVF sec. 4.1): error bounds at a small size, `tvf` against PySPH's,
+//! the effect of the correction terms at Re = 1000 (figs. 10-11), convergence with
+//! resolution (figs. 8-9), thread-count independence and bit-for-bit restart.
 //!
 //! The bounds below were measured on this code and are stated with the measured value; a
 //! change that makes the solution worse than the bound fails here.
@@ -59,6 +59,26 @@ fn small_run_errors_stay_within_measured_bounds() {
             "{scheme}+{pst} ({rates_at}): max |u| decay error {} >= {decay_bound}",
             m["umax_decay_rel_error"]
         );
+    }
+}
+
+/// `tvf` is the scheme PySPH 1.0b2 runs as `pysph run taylor_green --scheme tvf` (Adami et
+/// al. 2013: summation density, state equation, background pressure p_b = rho0 c0^2): its L1
+/// error follows the peer's, including where that is large. The state equation cannot hold
+/// the initial pressure of eq. (65), so both codes start from p = 0 and end tens of per cent
+/// off the exact solution, where `edac` ends within 2 %. PySPH's values were measured with
+/// `../shared/peers/pysph-taylor-green.sh --scheme tvf` (session 31); ours then agreed to
+/// 0.2 % (nx = 50), 1.9 % and 3.9 % (nx = 32). A tenth apart still tells the peer's scheme
+/// from the others: in the nx = 32 runs `edac` ends at 2.1 % and 9.0 %, `ctvf` with Sun's
+/// shifting at 6.5 % and 17.8 %.
+#[test]
+fn tvf_follows_pysphs_tvf() {
+    // (nx, Re, tf, PySPH's L1 at tf)
+    let cases = [(50, 100, "2.0", 0.4528), (32, 100, "1.0", 0.3544), (32, 1000, "1.0", 0.3278)];
+    for (nx, re, tf, peer) in cases {
+        let m = run(&["scheme=tvf", &format!("nx={nx}"), &format!("re={re}"), &format!("tf={tf}")]);
+        let l1 = m["l1_velocity_final"];
+        assert!((l1 / peer - 1.0).abs() < 0.1, "tvf, nx = {nx}, Re = {re}: L1 {l1} against PySPH's {peer}");
     }
 }
 
