@@ -723,9 +723,13 @@ fn expand(
                 })
                 .collect();
         }
+        let given = |k: &str| file.params.contains_key(k) || set_keys.iter().any(|(s, _)| s == k);
         for p in combos {
             let cname = case_name(g.name.as_deref(), &set_keys, &p)
                 .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
+            if let Some((key, why)) = scenes::common::unused_scheme_option(&p, given) {
+                return Err(loc.err(gspan.clone(), key, format!("= {} in case `{cname}` {why}", p.0[key])));
+            }
             if !valid_name(&cname) {
                 return Err(loc.err(
                     gspan.clone(),
@@ -1190,6 +1194,14 @@ max = 1.0
             GOOD.replace("[[figures]]", "[[cases]]\nname = \"sun-nx12\"\nparams = { re = 5 }\n[[figures]]");
         let e = p(&dup).unwrap_err();
         assert!(e.contains("sun-nx12") && e.contains("two cases"), "{e}");
+        // A scheme option in a case whose scheme does not read it: the `edac` case of the
+        // grid, named, with the key and value.
+        let ignored = GOOD.replace("grid = { scheme", "params = { pst = \"ipst\" }\ngrid = { scheme");
+        let e = p(&ignored).unwrap_err();
+        assert!(e.starts_with("x.toml:") && e.contains("`pst`") && e.contains("ipst"), "{e}");
+        assert!(e.contains("`scheme` = edac") && e.contains("case `"), "{e}");
+        // Switched off, it passes.
+        assert!(p(&GOOD.replace("grid = { scheme", "params = { pst = \"none\" }\ngrid = { scheme")).is_ok());
     }
 
     /// A profile figure appended to [`GOOD`], with a reference file in

@@ -151,6 +151,52 @@ impl FluidConstants {
     }
 }
 
+/// A scheme option given for a scheme that does not read it, as `(key, why)`: particle
+/// shifting and the CTVF correction terms act in `ctvf` only (`edac` and `tvf` homogenise
+/// the particles with a background pressure), IPST's settings with `pst = ipst` only, and
+/// `edac_alpha` not in `tvf` (its pressure comes from the state equation). Such a value would
+/// be ignored without a word: a run asked for as "edac with IPST" would be plain `edac`.
+/// `given` says which keys were set (on the command line, or by a problem file); the values
+/// that switch an option off (`pst = none`, `corrections = none`, `corr_* = off`) pass.
+/// Scenes without scheme parameters pass.
+pub fn unused_scheme_option(p: &Params, given: impl Fn(&str) -> bool) -> Option<(&'static str, String)> {
+    let scheme = match p.0.get("scheme") {
+        Some(super::params::Value::Str(s)) => s.as_str(),
+        _ => return None,
+    };
+    let ctvf = scheme == "ctvf";
+    let not_ctvf = || {
+        format!(
+            "has no effect with `scheme` = {scheme}: particle shifting and the correction terms are ctvf's (edac and tvf homogenise with a background pressure)"
+        )
+    };
+    let off = |key: &str| match key {
+        "pst" | "corrections" => p.str(key) == "none",
+        _ => p.str(key) != "on",
+    };
+    for key in ["pst", "corrections", "corr_continuity", "corr_pressure", "corr_momentum"] {
+        if !ctvf && given(key) && !off(key) {
+            return Some((key, not_ctvf()));
+        }
+    }
+    for key in ["ipst_tol", "ipst_max_iter", "ipst_interval"] {
+        if given(key) && !(ctvf && p.str("pst") == "ipst") {
+            let why = if ctvf { format!("`pst` = {}", p.str("pst")) } else { format!("`scheme` = {scheme}") };
+            return Some((
+                key,
+                format!("has no effect with {why}: IPST's settings act with scheme = ctvf and pst = ipst"),
+            ));
+        }
+    }
+    if scheme == "tvf" && given("edac_alpha") {
+        return Some((
+            "edac_alpha",
+            "has no effect with `scheme` = tvf: its pressure comes from the state equation".into(),
+        ));
+    }
+    None
+}
+
 /// Refuses the internal-flow schemes for a scene with a free surface.
 pub fn require_free_surface_scheme(scene: &str, p: &Params) -> Result<(), String> {
     if p.str("scheme") == "ctvf" {

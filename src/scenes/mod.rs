@@ -115,6 +115,9 @@ impl SceneEntry {
             }
             p.set_str(self.name, &specs, k, v)?;
         }
+        if let Some((key, why)) = common::unused_scheme_option(&p, |k| given.contains_key(k)) {
+            return Err(format!("scene `{}`: parameter `{key}` = {} {why}", self.name, p.0[key]));
+        }
         Ok(p)
     }
 }
