@@ -237,15 +237,14 @@ fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Resul
         .iter()
         .find(|v| v.0 == variant)
         .ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
-    let p = taylor_green::params_from(&[
-        &format!("nx={nx}"),
-        &format!("scheme={scheme}"),
-        &format!("pst={pst}"),
-        &format!("kernel={kernel}"),
-        "re=100",
-        "perturb=0.05",
-        "ipst_tol=1e-12",
-    ])?;
+    let (nx, scheme, kernel) = (format!("nx={nx}"), format!("scheme={scheme}"), format!("kernel={kernel}"));
+    let pst_set = format!("pst={pst}");
+    let mut sets =
+        vec![nx.as_str(), scheme.as_str(), pst_set.as_str(), kernel.as_str(), "re=100", "perturb=0.05"];
+    if *pst == "ipst" {
+        sets.push("ipst_tol=1e-12");
+    }
+    let p = taylor_green::params_from(&sets)?;
     let mut sim = taylor_green::simulation::<2>(&p)?;
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;

@@ -62,7 +62,7 @@ fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
         ("taylor_green", &["nx=8", "nx=10"], &["nx=8", "nx=10", "twice"]),
         // An option the scheme does not read would be ignored without a word.
         ("taylor_green", &["scheme=edac", "pst=ipst"], &["pst", "ipst", "edac"]),
-        ("taylor_green", &["scheme=edac", "corrections=all"], &["corrections", "all", "edac"]),
+        ("taylor_green", &["scheme=edac", "corr_pressure=on"], &["corr_pressure", "on", "edac"]),
         ("taylor_green", &["scheme=tvf", "corr_momentum=on"], &["corr_momentum", "on", "tvf"]),
         ("taylor_green", &["pst=sun", "ipst_tol=0.1"], &["ipst_tol", "0.1", "sun"]),
         ("taylor_green", &["scheme=tvf", "edac_alpha=1"], &["edac_alpha", "1", "tvf"]),

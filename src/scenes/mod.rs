@@ -115,7 +115,11 @@ impl SceneEntry {
             }
             p.set_str(self.name, &specs, k, v)?;
         }
-        if let Some((key, why)) = common::unused_scheme_option(&p, |k| given.contains_key(k)) {
+        // A default value counts as not given: the runner passes every resolved parameter of
+        // a case, defaults included, and its problem file was checked with the keys it gives.
+        let defaults = Params::defaults(&specs);
+        let given = |k: &str| given.contains_key(k) && p.0.get(k) != defaults.0.get(k);
+        if let Some((key, why)) = common::unused_scheme_option(&p, given) {
             return Err(format!("scene `{}`: parameter `{key}` = {} {why}", self.name, p.0[key]));
         }
         Ok(p)
