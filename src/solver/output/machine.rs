@@ -1,5 +1,5 @@
 //! The machine a run or a bench sitting ran on, part of its provenance: wall times and
-//! throughput only compare within one kind of host (the README's throughput table is kept
+//! throughput only compare within one kind of host (docs/throughput.md keeps its figures
 //! per CPU family and model), and the same source runs its pair loops on different vector
 //! widths from host to host (`target-cpu=native`).
 
