@@ -684,6 +684,10 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     let provenance = sphrepro::solver::output::summary::Provenance::now(started);
     println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", provenance.machine.describe());
     println!("{}", bench::table(&results, &peers));
+    let targets = bench::targets::targets(&results, &peers);
+    if !targets.is_empty() {
+        println!("Against the targets of issue 3, in this sitting:\n\n{}", bench::targets::table(&targets));
+    }
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {
             eprintln!("error: {}: {e}", dir.display());
@@ -691,7 +695,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
         }
     }
     let text = serde_json::to_string_pretty(
-        &serde_json::json!({ "provenance": provenance, "results": results, "peers": peers }),
+        &serde_json::json!({ "provenance": provenance, "results": results, "peers": peers, "targets": targets }),
     )
     .expect("serialises");
     if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {

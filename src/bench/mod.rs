@@ -5,6 +5,8 @@
 //! run side by side in one process (`bench-interleaved`), stepped in turn, so that the
 //! machine's slow spells fall on all of them alike.
 
+pub mod targets;
+
 use crate::scenes::taylor_green;
 use crate::solver::simulation::{PhaseTimes, Simulation};
 use crate::solver::warm;
@@ -495,27 +497,61 @@ fn millions(speed: f64, runs: &[f64]) -> String {
     }
 }
 
-/// The ratio `a / b` of two throughputs, as `digits` decimals and a `suffix`: with as many
-/// runs of each (`bench --repeat`, or the rounds of `--interleave`), the median of the
-/// rounds' own ratios with their range, since a slow spell of a noisy machine that falls on
-/// both runs of a round cancels in their ratio, and the range shows how far a target holds
-/// in single rounds; from six rounds on also the 95 % confidence interval of that median
-/// (in brackets, [`median_interval`]), which says whether a target holds in the median;
-/// otherwise the ratio of the two (median) runs.
-fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> String {
-    let (a_runs, b_runs) = (a.runs(), b.runs());
-    if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
-        return format!("{:.digits$}{suffix}", a.speed() / b.speed());
+/// The ratio `a / b` of two throughputs over a sitting: with as many runs of each (`bench
+/// --repeat`, or the rounds of `--interleave`), the median of the rounds' own ratios, since
+/// a slow spell of a noisy machine that falls on both runs of a round cancels in their
+/// ratio, with their range (how far a target holds in single rounds) and, from six rounds
+/// on, the 95 % confidence interval of that median ([`median_interval`]: whether a target
+/// holds in the median); otherwise the ratio of the two (median) runs.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct Ratio {
+    /// The median of the rounds' ratios (of an even count, the mean of the two middle
+    /// ones), or the ratio of the median runs.
+    pub median: f64,
+    /// The 95 % confidence interval of the median, from six rounds on.
+    pub interval: Option<(f64, f64)>,
+    /// The smallest and largest ratio of a round.
+    pub range: (f64, f64),
+    /// Rounds compared (1: the median runs only).
+    pub rounds: usize,
+}
+
+impl Ratio {
+    /// `a / b`, round by round where both ran as many rounds.
+    pub fn of(a: &impl Repeated, b: &impl Repeated) -> Self {
+        let (a_runs, b_runs) = (a.runs(), b.runs());
+        if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
+            let r = a.speed() / b.speed();
+            return Self { median: r, interval: None, range: (r, r), rounds: 1 };
+        }
+        let mut rounds: Vec<f64> = a_runs.iter().zip(b_runs).map(|(a, b)| a / b).collect();
+        rounds.sort_by(f64::total_cmp);
+        let n = rounds.len();
+        Self {
+            // Of an even count, the mean of the two middle ratios (neither favoured).
+            median: (rounds[(n - 1) / 2] + rounds[n / 2]) / 2.0,
+            interval: median_interval(&rounds),
+            range: (rounds[0], rounds[n - 1]),
+            rounds: n,
+        }
     }
-    let mut rounds: Vec<f64> = a_runs.iter().zip(b_runs).map(|(a, b)| a / b).collect();
-    rounds.sort_by(f64::total_cmp);
-    let (lo, hi) = (rounds[0], rounds[rounds.len() - 1]);
-    // Of an even count, the mean of the two middle ratios (neither favoured).
-    let n = rounds.len();
-    let median = (rounds[(n - 1) / 2] + rounds[n / 2]) / 2.0;
-    let interval =
-        median_interval(&rounds).map_or(String::new(), |(l, h)| format!(" [{l:.digits$}-{h:.digits$}]"));
-    format!("{median:.digits$}{suffix}{interval} ({lo:.digits$}-{hi:.digits$})")
+
+    /// As the table gives it: `digits` decimals and a `suffix`, then the interval in
+    /// brackets and the range in parentheses when there were rounds.
+    pub fn format(&self, digits: usize, suffix: &str) -> String {
+        let median = self.median;
+        if self.rounds < 2 {
+            return format!("{median:.digits$}{suffix}");
+        }
+        let interval = self.interval.map_or(String::new(), |(l, h)| format!(" [{l:.digits$}-{h:.digits$}]"));
+        let (lo, hi) = self.range;
+        format!("{median:.digits$}{suffix}{interval} ({lo:.digits$}-{hi:.digits$})")
+    }
+}
+
+/// [`Ratio::of`] `a / b`, formatted ([`Ratio::format`]).
+fn ratio(a: &impl Repeated, b: &impl Repeated, digits: usize, suffix: &str) -> String {
+    Ratio::of(a, b).format(digits, suffix)
 }
 
 /// A 95 % confidence interval of the median of the `sorted` samples, free of any assumption
