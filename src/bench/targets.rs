@@ -163,29 +163,19 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
         }
     }
     for &t in &threads {
-        let points: Vec<(usize, f64)> = sizes
-            .iter()
-            .filter_map(|&nx| ours("edac", nx, t, 1).map(|r| (r.particles, r.particle_steps_per_second)))
-            .collect();
-        if points.len() >= 2 {
-            let ns: Vec<String> = points.iter().map(|&(_, s)| format!("{:.0}", 1e9 / s)).collect();
+        let edac: Vec<&BenchResult> = sizes.iter().filter_map(|&nx| ours("edac", nx, t, 1)).collect();
+        if edac.len() >= 2 {
+            let list = |f: &dyn Fn(&BenchResult) -> String| edac.iter().map(|r| f(r)).collect::<Vec<_>>();
             let case = format!(
                 "edac, {t} thread(s): ns a particle-step {} at nx = {}; exponent of N",
-                ns.join(" / "),
-                sizes
-                    .iter()
-                    .filter(|&&nx| ours("edac", nx, t, 1).is_some())
-                    .map(|n| n.to_string())
-                    .collect::<Vec<_>>()
-                    .join(", ")
+                list(&|r| format!("{:.0}", 1e9 / r.particle_steps_per_second)).join(" / "),
+                list(&|r| r.nx.to_string()).join(", ")
             );
+            let points: Vec<(usize, f64)> =
+                edac.iter().map(|r| (r.particles, r.particle_steps_per_second)).collect();
             let target = "cost a particle-step flat from nx = 50 to 400 (O(N))";
-            rows.push(TargetRow::new(
-                target,
-                case,
-                single(cost_exponent(&points)),
-                Bound::AtMost(FLAT_EXPONENT),
-            ));
+            let exponent = single(cost_exponent(&points));
+            rows.push(TargetRow::new(target, case, exponent, Bound::AtMost(FLAT_EXPONENT)));
         }
     }
     for &nx in sizes.iter().filter(|&&nx| nx >= 100) {
