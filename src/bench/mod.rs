@@ -150,20 +150,28 @@ pub trait Repeated: Clone {
     fn runs_mut(&mut self) -> &mut Vec<f64>;
 }
 
+/// The [`Repeated`] methods of a result that holds its `particle_steps_per_second` and the
+/// `runs` of its configuration (ours and the peer's alike).
+macro_rules! throughput_and_runs {
+    () => {
+        fn speed(&self) -> f64 {
+            self.particle_steps_per_second
+        }
+        fn runs(&self) -> &[f64] {
+            &self.runs
+        }
+        fn runs_mut(&mut self) -> &mut Vec<f64> {
+            &mut self.runs
+        }
+    };
+}
+
 impl Repeated for BenchResult {
     type Key = (String, String, usize, usize, usize);
     fn key(&self) -> Self::Key {
         (self.variant.clone(), self.kernel.clone(), self.nx, self.threads, self.copies)
     }
-    fn speed(&self) -> f64 {
-        self.particle_steps_per_second
-    }
-    fn runs(&self) -> &[f64] {
-        &self.runs
-    }
-    fn runs_mut(&mut self) -> &mut Vec<f64> {
-        &mut self.runs
-    }
+    throughput_and_runs!();
 }
 
 impl Repeated for PeerResult {
@@ -171,15 +179,7 @@ impl Repeated for PeerResult {
     fn key(&self) -> Self::Key {
         (self.nx, self.threads)
     }
-    fn speed(&self) -> f64 {
-        self.particle_steps_per_second
-    }
-    fn runs(&self) -> &[f64] {
-        &self.runs
-    }
-    fn runs_mut(&mut self) -> &mut Vec<f64> {
-        &mut self.runs
-    }
+    throughput_and_runs!();
 }
 
 /// One result per configuration from repeated runs of each, in the order the
