@@ -521,8 +521,7 @@ impl Ratio {
     pub fn of(a: &impl Repeated, b: &impl Repeated) -> Self {
         let (a_runs, b_runs) = (a.runs(), b.runs());
         if a_runs.len() < 2 || a_runs.len() != b_runs.len() {
-            let r = a.speed() / b.speed();
-            return Self { median: r, interval: None, range: (r, r), rounds: 1 };
+            return Self::single(a.speed() / b.speed());
         }
         let mut rounds: Vec<f64> = a_runs.iter().zip(b_runs).map(|(a, b)| a / b).collect();
         rounds.sort_by(f64::total_cmp);
@@ -534,6 +533,12 @@ impl Ratio {
             range: (rounds[0], rounds[n - 1]),
             rounds: n,
         }
+    }
+
+    /// One value, not a ratio of rounds: the ratio of two median runs, an L1 error ratio, a
+    /// fitted exponent.
+    pub fn single(v: f64) -> Self {
+        Self { median: v, interval: None, range: (v, v), rounds: 1 }
     }
 
     /// As the table gives it: `digits` decimals and a `suffix`, then the interval in
@@ -684,7 +689,7 @@ mod peer_tests {
     use super::*;
 
     /// A measured configuration with nothing but its name and throughput.
-    fn sample(variant: &str, nx: usize, threads: usize, speed: f64) -> BenchResult {
+    pub(super) fn sample(variant: &str, nx: usize, threads: usize, speed: f64) -> BenchResult {
         BenchResult {
             variant: variant.into(),
             kernel: DEFAULT_KERNEL.into(),

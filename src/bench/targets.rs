@@ -82,11 +82,6 @@ impl TargetRow {
     }
 }
 
-/// A measure that is not a ratio of rounds (an L1 error ratio, a fitted exponent).
-fn single(v: f64) -> Ratio {
-    Ratio { median: v, interval: None, range: (v, v), rounds: 1 }
-}
-
 /// The largest exponent `e` of a cost growing as `N^e` that still counts as flat. Over the
 /// 64-fold growth of N from nx = 50 to 400 an O(N log N) cost would show `e` of about 0.10
 /// (`ln(ln 160000 / ln 2500) / ln 64`); 0.05 lies halfway between that and O(N).
@@ -141,7 +136,7 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
             rows.push(TargetRow::new(
                 "edac at nx = 50: L1 error no worse than the peer's",
                 case,
-                single(mine / theirs),
+                Ratio::single(mine / theirs),
                 Bound::AtMost(1.0),
             ));
         }
@@ -174,7 +169,7 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
             let points: Vec<(usize, f64)> =
                 edac.iter().map(|r| (r.particles, r.particle_steps_per_second)).collect();
             let target = "cost a particle-step flat from nx = 50 to 400 (O(N))";
-            let exponent = single(cost_exponent(&points));
+            let exponent = Ratio::single(cost_exponent(&points));
             rows.push(TargetRow::new(target, case, exponent, Bound::AtMost(FLAT_EXPONENT)));
         }
     }
@@ -227,28 +222,14 @@ pub fn table(rows: &[TargetRow]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::DEFAULT_KERNEL;
+    use super::super::peer_tests::sample;
     use super::*;
 
+    /// A configuration with its runs, the median run's throughput as its own.
     fn run(variant: &str, nx: usize, threads: usize, copies: usize, runs: Vec<f64>) -> BenchResult {
         let mut sorted = runs.clone();
         sorted.sort_by(f64::total_cmp);
-        BenchResult {
-            variant: variant.into(),
-            kernel: DEFAULT_KERNEL.into(),
-            nx,
-            threads,
-            copies,
-            particles: nx * nx,
-            steps: 100,
-            seconds: 1.0,
-            particle_steps_per_second: sorted[(sorted.len() - 1) / 2],
-            peak_rss_bytes: 0,
-            bytes_per_particle: 0.0,
-            ipst_iterations_mean: 10.0,
-            phase_shares: Default::default(),
-            runs,
-        }
+        BenchResult { copies, runs, ..sample(variant, nx, threads, sorted[(sorted.len() - 1) / 2]) }
     }
 
     fn peer(nx: usize, speed: f64, runs: Vec<f64>) -> PeerResult {
@@ -290,7 +271,7 @@ mod tests {
         assert_eq!(v(six(2.5, 2.9), Bound::AtMost(3.0)), Verdict::Met);
         let three = Ratio { median: 1.75, interval: None, range: (1.5, 1.9), rounds: 3 };
         assert_eq!(v(three, Bound::AtLeast(1.7)), Verdict::Met);
-        assert_eq!(v(single(3.2), Bound::AtMost(3.0)), Verdict::Missed);
+        assert_eq!(v(Ratio::single(3.2), Bound::AtMost(3.0)), Verdict::Missed);
     }
 
     /// A cost a particle-step of `a N^e` gives back `e`; flat costs give 0.
