@@ -7,14 +7,14 @@
 //! top of every run log.
 
 mod free_surface;
+mod ipst;
 mod passes;
 mod plan;
 mod walls;
 
 pub use free_surface::SurfaceFields;
-pub use passes::{
-    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, FluidPasses, KernelList,
-};
+pub use ipst::ipst_chi_reference;
+pub use passes::{build_kernel_list, build_kernel_list_summing_density, FluidPasses, KernelList};
 pub use walls::WallSet;
 
 use serde::{Deserialize, Serialize};

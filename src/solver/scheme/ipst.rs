@@ -1,0 +1,422 @@
+//! IPST, the iterative particle shifting of Huang et al. (2019) as the CTVF paper uses it
+//! (sec. 3.3.2, eqs. 37-41): copies of the particles are moved, up to `max_iter` times a
+//! step, by `U_max dt sum V_b n_ab W_ab`, and the move becomes a homogenisation
+//! acceleration. Unlike the gather passes of [`passes`](super::passes), each sweep
+//! evaluates every fluid pair once and adds it to both particles, in slabs fixed by the
+//! geometry ([`Slabs`]), so that its sums, too, do not depend on the thread count.
+
+use super::passes::{FluidPasses, KernelList, PairKernel, MIN_LEN};
+use super::{FluidScheme, Shifting, SurfaceFields, WallSet};
+use crate::solver::equations::{free_surface, shifting};
+use crate::solver::kernel::{Kernel, ScaledKernel};
+use crate::solver::math::Vector;
+use crate::solver::nnps::{CellList, HalfPairs, PairSlices, Slabs};
+use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::LIGHT_LOOP_LEN;
+use rayon::prelude::*;
+
+/// IPST's work space, kept from step to step (it grows on first use, in scenes that
+/// declare IPST only).
+#[derive(Clone, Debug, Default)]
+pub(super) struct IpstWork<const D: usize> {
+    /// The moved positions of the current sweep, and of the next.
+    x_shift: Vec<Vector<D>>,
+    x_next: Vec<Vector<D>>,
+    pub(super) slabs: Slabs,
+    slab_work: Vec<IpstSlab<D>>,
+    /// Each particle's sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
+    sums: Vec<(Vector<D>, f64)>,
+    /// Each slab's largest chi in the last sweep.
+    slab_chi_max: Vec<f64>,
+    /// The fluid's and the walls' volumes, as compact arrays.
+    vol: Vec<f64>,
+    wall_vol: Vec<f64>,
+}
+
+impl<const D: usize> FluidPasses<D> {
+    /// IPST (eqs. 37-41): move copies of the particles by `U_max dt sum V_b n_ab W_ab` until
+    /// `|max chi - chi_ref| <= tol chi_ref` (eq. 39, chi of eq. 40) or `max_iter` moves,
+    /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41), on steps whose index `step` is a
+    /// multiple of the scheme's interval (every step by default, as the paper says), with
+    /// `(du/dt)_c = 0` on the others. The particles themselves are not
+    /// moved: the kick of the next step applies the displacement through u~. Walls are
+    /// fixed neighbours.
+    ///
+    /// The iterations reuse the step's neighbour lists with the kernel re-evaluated at the
+    /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
+    /// are those entering the support from outside it during the iterations, whose kernel
+    /// value is of the fifth order in the distance they moved in (quintic spline).
+    /// Each fluid pair is evaluated once a sweep and adds to both particles (`W_ab` and
+    /// `r_ab` are symmetric, `x_ba = -x_ab`), in the slabs of `cells` (see [`Slabs`]), so
+    /// that the sums do not depend on the thread count. `cells` must have binned the fluid
+    /// in its current order. Returns the number of moves made.
+    #[allow(clippy::too_many_arguments)]
+    pub fn ipst(
+        &mut self,
+        fluid: &Fluid<D>,
+        nl: &KernelList<D>,
+        cells: &CellList<D>,
+        walls: Option<&WallSet<D>>,
+        surface: Option<&SurfaceFields<D>>,
+        k: &Kernel,
+        s: &FluidScheme,
+        rates: &mut FluidRates<D>,
+        dt: f64,
+        step: u64,
+    ) -> usize {
+        let w = &mut self.ipst;
+        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref }) =
+            s.transport.map(|t| t.shifting)
+        else {
+            return 0;
+        };
+        if !step.is_multiple_of(interval as u64) {
+            rates.a_c.par_iter_mut().with_min_len(MIN_LEN).for_each(|ac| *ac = Vector::zeros());
+            return 0;
+        }
+        let k = k.scaled(fluid.h);
+        let n = fluid.len();
+        w.x_shift.clear();
+        w.x_shift.extend_from_slice(&fluid.x);
+        w.x_next.resize(n, Vector::zeros());
+        w.sums.resize(n, (Vector::zeros(), 0.0));
+        // The volumes gathered by `accelerations` at these positions, as compact arrays
+        // (the sweeps read nothing else of the neighbours).
+        w.vol.resize(n, 0.0);
+        let pts = &self.points;
+        w.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = pts[i].v());
+        w.wall_vol.clear();
+        w.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
+        w.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
+        w.slab_work.resize_with(w.slabs.len(), IpstSlab::default);
+        w.slab_chi_max.resize(w.slabs.len(), f64::MIN);
+        let (vol, wall_vol, slabs) = (&w.vol, &w.wall_vol, &w.slabs);
+        w.slab_work.par_iter_mut().enumerate().for_each(|(t, slab)| {
+            nl.half_pairs(slabs.range(t), &mut slab.half);
+            slab.half.gather(vol, &mut slab.vol);
+        });
+        // A particle's own share of chi (its pair with itself is not in the half list).
+        let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
+        let walls = walls.map(|ws| (ws, &wall_vol[..]));
+        let mut iterations = 0;
+        while iterations < max_iter {
+            // One sweep: the sums of eqs. (37) and (40) at the current positions, each slab's
+            // pairs in parallel (the shares of other slabs' particles set aside); then, slab by
+            // slab in parallel, the shares set aside, chi and the moved positions (eq. 37) into
+            // a second buffer, used if chi has not converged.
+            let xs: &[Vector<D>] = &w.x_shift;
+            slabs.for_each_mut(&mut w.sums[..], &mut w.slab_work, &|t, sums, slab| {
+                slab.sweep(slabs.range(t), sums, xs, nl, vol, walls, &k, chi_self);
+            });
+            let done = &w.slab_work;
+            let data = (&mut w.sums[..], &mut w.x_next[..]);
+            slabs.for_each_mut(data, &mut w.slab_chi_max, &|t, (sums, next), chi_max| {
+                let range = slabs.range(t);
+                for source in slabs.spill_sources(t) {
+                    for &(j, d, chi) in &done[source].spill {
+                        if let Some(sum) = (j as usize).checked_sub(range.start).and_then(|l| sums.get_mut(l))
+                        {
+                            sum.0 += d;
+                            sum.1 += chi;
+                        }
+                    }
+                }
+                *chi_max = f64::MIN;
+                for ((i, &(d, chi)), next) in range.zip(sums.iter()).zip(next) {
+                    let mut dr = d * (u_max * dt);
+                    if let Some(fs) = surface {
+                        // eq. (45)
+                        dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+                    }
+                    // Not wrapped: the list's image shifts refer to the unwrapped positions.
+                    *next = xs[i] + dr;
+                    *chi_max = chi_max.max(chi);
+                }
+            });
+            // The largest chi (max is exact: any grouping gives the same).
+            let chi_max = w.slab_chi_max.iter().fold(f64::MIN, |m, &c| m.max(c));
+            if (chi_max - chi_ref).abs() <= tol * chi_ref {
+                break;
+            }
+            std::mem::swap(&mut w.x_shift, &mut w.x_next);
+            iterations += 1;
+        }
+        let f = 2.0 / (dt * dt);
+        let (x0, xs) = (&fluid.x, &w.x_shift);
+        rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
+            *ac = (xs[i] - x0[i]) * f;
+        });
+        iterations
+    }
+}
+
+/// Fewest particles in an IPST slab on average: enough that a task is long against rayon's
+/// scheduling. Fixed, as [`IPST_SLAB_LAYERS`], so that the slabs, and with them the sums, do
+/// not depend on the thread count.
+const IPST_SLAB: usize = 1024;
+/// Fewest cell layers in an IPST slab: the pairs between a slab's last layer and the next
+/// slab's first are set aside and added in a second loop, at about twice the cost of a pair
+/// within the slab, so thin slabs cost more. Eight rather than four took 4-7 % off a sweep
+/// on one thread and about 10 % on two at nx = 100 (session 28, samples in the sweeps
+/// against the rest of the step), and still gives two slabs at nx = 50.
+const IPST_SLAB_LAYERS: usize = 8;
+/// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
+/// cache level, and the vectorised loops run over the group's pairs, padded once. Sixteen
+/// rather than eight: 3-7 % off a sweep on one thread (fewer padded lanes and loop ends).
+const IPST_GROUP: usize = 16;
+/// Vector lanes the pair arrays are padded to.
+const LANES: usize = 8;
+
+/// One IPST slab's work space, kept from step to step: its pair arrays, and the shares of
+/// its pairs that belong to particles of other slabs, `(j, V_a W_ab x_ba / r, h^2 W_ab)`.
+#[derive(Clone, Debug, Default)]
+struct IpstSlab<const D: usize> {
+    /// The slab's fluid pairs `j > i`, listed once a step,
+    half: HalfPairs,
+    /// and their neighbours' volumes `V_j`, which the moves do not change.
+    vol: Vec<f64>,
+    pairs: IpstPairs<D>,
+    spill: Vec<(u32, Vector<D>, f64)>,
+}
+
+impl<const D: usize> IpstSlab<D> {
+    /// The slab's share of one sweep: for its particles `particles` (whose sums `sums`
+    /// it zeroes first), each fluid pair `j > i` once, added to both particles (to `j`'s
+    /// spill if `j` is outside the slab), and each wall pair.
+    #[allow(clippy::too_many_arguments)]
+    fn sweep(
+        &mut self,
+        particles: std::ops::Range<usize>,
+        sums: &mut [(Vector<D>, f64)],
+        xs: &[Vector<D>],
+        nl: &KernelList<D>,
+        vol: &[f64],
+        walls: Option<(&WallSet<D>, &[f64])>,
+        k: &ScaledKernel,
+        chi_self: f64,
+    ) {
+        sums.fill((Vector::zeros(), 0.0));
+        self.spill.clear();
+        let first = particles.start;
+        for group in particles.step_by(IPST_GROUP) {
+            let group = group..(group + IPST_GROUP).min(first + sums.len());
+            let p = &mut self.pairs;
+            p.evaluate(group.clone(), xs, nl, &self.half, walls, k);
+            for (l, i) in group.enumerate() {
+                let (fluid, wall) = p.ranges(l);
+                let v_i = vol[i];
+                let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
+                let (pair_x, pair_fw) = (&p.xij[fluid.clone()], &p.fw[fluid]);
+                let span = self.half.span(i);
+                let (pair_v, pair_j) = (&self.vol[span.clone()], self.half.neighbours(span));
+                let pairs = pair_x.iter().zip(pair_fw).zip(pair_v.iter().zip(pair_j));
+                for ((&xij, &(f, w)), (&v_j, j)) in pairs {
+                    d += xij * (f * v_j);
+                    chi += w;
+                    // x_ji = -x_ij
+                    let share = xij * -(f * v_i);
+                    let slot = j as usize - first;
+                    if slot < sums.len() {
+                        sums[slot].0 += share;
+                        sums[slot].1 += w;
+                    } else {
+                        self.spill.push((j, share, w));
+                    }
+                }
+                for q in wall {
+                    let (f, w) = p.fw[q];
+                    d += p.xij[q] * (f * p.vol[q]);
+                    chi += w;
+                }
+                let sum = &mut sums[i - first];
+                sum.0 += d;
+                sum.1 += chi;
+            }
+        }
+        // Room for a quarter more shares set aside, so that later sweeps do not allocate.
+        let want = self.spill.len() + self.spill.len() / 4 + 64;
+        self.spill.reserve(want.saturating_sub(self.spill.len()));
+    }
+}
+
+/// The pairs of a group of particles at moved positions, as arrays (reused from group to
+/// group), for the IPST sums of eqs. (37) and (40): for each particle its fluid pairs
+/// `j > i`, then its wall pairs. The distances, the kernel and the factors are evaluated
+/// for all the pairs at once in vectorised loops.
+#[derive(Clone, Debug, Default)]
+struct IpstPairs<const D: usize> {
+    /// Where each particle's fluid pairs end, and where its wall pairs end.
+    fluid_end: Vec<usize>,
+    end: Vec<usize>,
+    xij: Vec<Vector<D>>,
+    /// The wall neighbours' volumes (at the wall pairs' slots; the fluid neighbours' are
+    /// the slab's).
+    vol: Vec<f64>,
+    /// `W_ab / r_ab` (eq. 37) and `h^2 W_ab` (eq. 40).
+    fw: Vec<(f64, f64)>,
+}
+
+impl<const D: usize> IpstPairs<D> {
+    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (the pairs
+    /// `j > i` only) and the walls (with their volumes).
+    fn evaluate(
+        &mut self,
+        particles: std::ops::Range<usize>,
+        xs: &[Vector<D>],
+        nl: &KernelList<D>,
+        half: &HalfPairs,
+        walls: Option<(&WallSet<D>, &[f64])>,
+        k: &ScaledKernel,
+    ) {
+        let to_wall = walls.map(|(ws, _)| &ws.fluid_to_wall);
+        let n: usize = particles.clone().map(|i| half.count(i) + to_wall.map_or(0, |l| l.count(i))).sum();
+        // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
+        // padding holds earlier (finite) values, which no sum reads.
+        let room = n.next_multiple_of(LANES);
+        if self.xij.len() < room {
+            // A quarter more than needed, so that groups with a few more pairs later on do
+            // not allocate.
+            let grown = (room + room / 4).next_multiple_of(LANES);
+            self.xij.resize(grown, Vector::zeros());
+            self.vol.resize(grown, 0.0);
+            self.fw.resize(grown, (0.0, 0.0));
+        }
+        self.fluid_end.clear();
+        self.end.clear();
+        let mut at = 0;
+        for i in particles {
+            at += nl.write_half_pairs(half, i, xs[i], xs, &mut self.xij[at..]);
+            self.fluid_end.push(at);
+            if let Some((ws, wall_vol)) = walls {
+                let out = PairSlices { xij: &mut self.xij[at..], value: &mut self.vol[at..] };
+                ws.fluid_to_wall.write_pairs(i, xs[i], &ws.wall.x, wall_vol, out);
+                at += ws.fluid_to_wall.count(i);
+            }
+            self.end.push(at);
+        }
+        k.map_batch(
+            &self.xij[..room],
+            &mut self.fw[..room],
+            |xij| xij.norm_squared().sqrt(),
+            |r, w| (shifting::ipst_factor(w, r), shifting::ipst_chi(k.h, w)),
+        );
+    }
+
+    /// The fluid pairs and the wall pairs of the `l`-th particle of the group last
+    /// evaluated.
+    #[inline(always)]
+    fn ranges(&self, l: usize) -> (std::ops::Range<usize>, std::ops::Range<usize>) {
+        let from = if l == 0 { 0 } else { self.end[l - 1] };
+        (from..self.fluid_end[l], self.fluid_end[l]..self.end[l])
+    }
+}
+
+/// chi_ref of eq. (39): the mean of `chi = h^2 sum W` over the initial configuration for
+/// internal flows (the authors' internal-flow choice: a perturbed lattice has no single
+/// value), the maximum with a free surface (CTVF sec. 3.3.2).
+pub fn ipst_chi_reference<const D: usize>(
+    fluid: &Fluid<D>,
+    nl: &KernelList<D>,
+    walls: Option<&WallSet<D>>,
+    free_surface: bool,
+) -> f64 {
+    let chi: Vec<f64> = (0..fluid.len())
+        .map(|i| {
+            let mut s = 0.0;
+            let mut add = |kw: &PairKernel| s += shifting::ipst_chi(fluid.h, kw.w);
+            nl.for_each(i, &fluid.x, |_, _, _, kw| add(kw));
+            if let Some(ws) = walls {
+                ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, _, _, kw| add(kw));
+            }
+            s
+        })
+        .collect();
+    if free_surface {
+        chi.iter().fold(f64::MIN, |m, &v| m.max(v))
+    } else {
+        chi.iter().sum::<f64>() / chi.len() as f64
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::scheme::passes::build_kernel_list;
+    use crate::solver::scheme::{FluidSettings, Pst, SchemeName};
+
+    /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
+    /// slabs, equals the direct sum of every particle over its whole neighbour list (to
+    /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
+    /// bit for bit the same on one and on two threads.
+    #[test]
+    fn ipst_pairs_once_equal_the_direct_sum() {
+        use crate::solver::kernel::KernelKind;
+        use crate::solver::nnps::Domain;
+        use crate::solver::particles::FluidInit;
+        let (n, dx) = (128, 1.0 / 128.0);
+        let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
+        let x: Vec<Vector<2>> = (0..n * n)
+            .map(|k| {
+                let (i, j) = ((k % n) as f64, (k / n) as f64);
+                Vector::<2>::new((i + 0.5 + 0.2 * wave(k, 1.3)) * dx, (j + 0.5 + 0.2 * wave(k, 2.1)) * dx)
+            })
+            .collect();
+        let init = FluidInit {
+            u: vec![Vector::<2>::zeros(); n * n],
+            m: (0..n * n).map(|k| dx * dx * (1.0 + 0.1 * wave(k, 0.9))).collect(),
+            rho: vec![1.0; n * n],
+            p: vec![0.0; n * n],
+            x,
+        };
+        let mut fluid = Fluid::new("f", dx, init, true).unwrap();
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let mut cells = CellList::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel.support() * dx);
+        cells.update(&fluid.x);
+        fluid.reorder(cells.order());
+        cells.mark_reordered();
+        let mut nl = KernelList::new();
+        build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        let settings = FluidSettings {
+            pst: Pst::Ipst,
+            ipst_max_iter: 1,
+            ..super::super::tests::internal_flow_settings()
+        };
+        let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+        let Some(Shifting::Ipst { u_max, .. }) = scheme.transport.map(|t| t.shifting) else {
+            panic!("IPST declared")
+        };
+        let dt = 1e-3;
+        let a_c = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let (mut passes, mut rates) =
+                    (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
+                passes.accelerations(&fluid, &nl, None, None, &scheme, &mut rates, dt);
+                passes.ipst(&fluid, &nl, &cells, None, None, &kernel, &scheme, &mut rates, dt, 0);
+                (rates.a_c, passes.ipst.slabs.len())
+            })
+        };
+        let ((one, slabs), (two, _)) = (a_c(1), a_c(2));
+        assert!(slabs >= 3, "{slabs} slabs");
+        assert!(one
+            .iter()
+            .zip(&two)
+            .all(|(a, b)| a[0].to_bits() == b[0].to_bits() && a[1].to_bits() == b[1].to_bits()));
+        let mut largest = 0.0f64;
+        for (i, a) in one.iter().enumerate() {
+            // The term of eq. (37) over the whole list.
+            let mut d = Vector::<2>::zeros();
+            nl.for_each(i, &fluid.x, |j, xij, r2, kw| {
+                d += shifting::ipst_displacement(fluid.m[j] / fluid.rho[j], &kw.pair(xij, r2, dx));
+            });
+            // eq. (41) of one move of eq. (37)
+            let direct = d * (u_max * dt) * (2.0 / (dt * dt));
+            assert!(
+                (a - direct).norm() <= 1e-9 * direct.norm().max(1e-3),
+                "particle {i}: {a:?} vs {direct:?}"
+            );
+            largest = largest.max(direct.norm());
+        }
+        assert!(largest > 1.0, "the perturbed lattice is shifted ({largest})");
+    }
+}
