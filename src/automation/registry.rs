@@ -657,6 +657,17 @@ fn check_metric(
 }
 
 #[allow(clippy::too_many_arguments)]
+/// What expanding one problem file has at hand: where its errors point, the file, its scene
+/// (and the scene's parameters), the preset and the file's variables.
+struct Expand<'a> {
+    loc: &'a Loc<'a>,
+    file: &'a ProblemFile,
+    scene: &'static SceneEntry,
+    specs: &'a [Spec],
+    preset: &'a str,
+    vars: &'a RawParams,
+}
+
 fn expand(
     loc: &Loc,
     file: &ProblemFile,
@@ -666,102 +677,149 @@ fn expand(
     preset: &str,
     vars: &RawParams,
 ) -> Result<Problem, String> {
-    // Problem-wide parameters over the defaults.
-    let mut base = Params::defaults(specs);
-    for (k, v) in &file.params {
-        match resolve_raw(loc, k, v, vars, preset)? {
-            Raw::One(x) => {
-                let x = check_param(loc, v.span(), scene, specs, k, &x)?;
-                base.0.insert(k.clone(), x);
-            }
-            Raw::List(_) => return Err(loc.err(v.span(), k, "a list is a grid: put it under [cases.grid]")),
-        }
-    }
-    let mut cases: Vec<Case> = Vec::new();
-    let mut case_lines: BTreeMap<String, usize> = BTreeMap::new();
-    for g in &file.cases {
-        let gspan = g.span();
-        let g = g.get_ref();
-        let mut fixed = base.clone();
-        let mut set_keys: Vec<(String, Vec<Value>)> = Vec::new();
-        for (k, v) in &g.params {
+    let x = Expand { loc, file, scene, specs, preset, vars };
+    let cases = x.cases()?;
+    // Figures and tables share one space of ids.
+    let mut ids: BTreeMap<String, usize> = BTreeMap::new();
+    let figures =
+        file.figures.iter().map(|f| x.figure(f, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
+    let tables = file.tables.iter().map(|t| x.table(t, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
+    let bounds =
+        file.bounds.iter().filter_map(|b| x.bound(b, &cases).transpose()).collect::<Result<Vec<_>, _>>()?;
+    Ok(Problem {
+        name: name.to_string(),
+        path: loc.path.to_path_buf(),
+        title: file.title.clone(),
+        description: file.description.clone(),
+        scene,
+        preset: preset.to_string(),
+        other_presets: Vec::new(),
+        cases,
+        figures,
+        tables,
+        bounds,
+    })
+}
+
+impl Expand<'_> {
+    /// The cases of the preset: the problem-wide parameters over the scene's defaults, then
+    /// each group's, its grid expanded (a simulation named twice, or named alike with
+    /// other parameters, is caught here).
+    fn cases(&self) -> Result<Vec<Case>, String> {
+        let Expand { loc, file, scene, specs, preset, vars } = *self;
+        // Problem-wide parameters over the defaults.
+        let mut base = Params::defaults(specs);
+        for (k, v) in &file.params {
             match resolve_raw(loc, k, v, vars, preset)? {
                 Raw::One(x) => {
                     let x = check_param(loc, v.span(), scene, specs, k, &x)?;
-                    fixed.0.insert(k.clone(), x.clone());
-                    set_keys.push((k.clone(), vec![x]));
+                    base.0.insert(k.clone(), x);
                 }
-                Raw::List(_) => return Err(loc.err(v.span(), k, "a list belongs under [cases.grid]")),
+                Raw::List(_) => {
+                    return Err(loc.err(v.span(), k, "a list is a grid: put it under [cases.grid]"))
+                }
             }
         }
-        for (k, v) in &g.grid {
-            let vals = match resolve_raw(loc, k, v, vars, preset)? {
-                Raw::One(x) => vec![x],
-                Raw::List(l) => l,
-            };
-            if vals.is_empty() {
-                return Err(loc.err(v.span(), k, "an empty list makes no case"));
+        let mut cases: Vec<Case> = Vec::new();
+        let mut case_lines: BTreeMap<String, usize> = BTreeMap::new();
+        for g in &file.cases {
+            let gspan = g.span();
+            let g = g.get_ref();
+            let mut fixed = base.clone();
+            let mut set_keys: Vec<(String, Vec<Value>)> = Vec::new();
+            for (k, v) in &g.params {
+                match resolve_raw(loc, k, v, vars, preset)? {
+                    Raw::One(x) => {
+                        let x = check_param(loc, v.span(), scene, specs, k, &x)?;
+                        fixed.0.insert(k.clone(), x.clone());
+                        set_keys.push((k.clone(), vec![x]));
+                    }
+                    Raw::List(_) => return Err(loc.err(v.span(), k, "a list belongs under [cases.grid]")),
+                }
             }
-            let vals = vals
-                .iter()
-                .map(|x| check_param(loc, v.span(), scene, specs, k, x))
-                .collect::<Result<Vec<_>, _>>()?;
-            set_keys.retain(|(s, _)| s != k);
-            set_keys.push((k.clone(), vals));
-        }
-        // Product of the grid (like automan's mdict/dprod).
-        let mut combos: Vec<Params> = vec![fixed];
-        for (k, vals) in &set_keys {
-            combos = combos
-                .into_iter()
-                .flat_map(|p| {
-                    vals.iter().map(move |v| {
-                        let mut q = p.clone();
-                        q.0.insert(k.clone(), v.clone());
-                        q
+            for (k, v) in &g.grid {
+                let vals = match resolve_raw(loc, k, v, vars, preset)? {
+                    Raw::One(x) => vec![x],
+                    Raw::List(l) => l,
+                };
+                if vals.is_empty() {
+                    return Err(loc.err(v.span(), k, "an empty list makes no case"));
+                }
+                let vals = vals
+                    .iter()
+                    .map(|x| check_param(loc, v.span(), scene, specs, k, x))
+                    .collect::<Result<Vec<_>, _>>()?;
+                set_keys.retain(|(s, _)| s != k);
+                set_keys.push((k.clone(), vals));
+            }
+            // Product of the grid (like automan's mdict/dprod).
+            let mut combos: Vec<Params> = vec![fixed];
+            for (k, vals) in &set_keys {
+                combos = combos
+                    .into_iter()
+                    .flat_map(|p| {
+                        vals.iter().map(move |v| {
+                            let mut q = p.clone();
+                            q.0.insert(k.clone(), v.clone());
+                            q
+                        })
                     })
-                })
-                .collect();
-        }
-        let given = |k: &str| file.params.contains_key(k) || set_keys.iter().any(|(s, _)| s == k);
-        for p in combos {
-            let cname = case_name(g.name.as_deref(), &set_keys, &p)
-                .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
-            if let Some((key, why)) = scenes::common::unused_scheme_option(&p, given) {
-                return Err(loc.err(gspan.clone(), key, format!("= {} in case `{cname}` {why}", p.0[key])));
+                    .collect();
             }
-            if !valid_name(&cname) {
-                return Err(loc.err(
-                    gspan.clone(),
-                    "cases.name",
-                    format!("case name `{cname}` may use letters, digits, `.`, `_` and `-` only"),
-                ));
-            }
-            if let Some(other) = cases.iter().find(|c| c.name == cname) {
-                if other.params == p {
-                    continue;
+            let given = |k: &str| file.params.contains_key(k) || set_keys.iter().any(|(s, _)| s == k);
+            for p in combos {
+                let cname = case_name(g.name.as_deref(), &set_keys, &p)
+                    .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
+                if let Some((key, why)) = scenes::common::unused_scheme_option(&p, given) {
+                    return Err(loc.err(
+                        gspan.clone(),
+                        key,
+                        format!("= {} in case `{cname}` {why}", p.0[key]),
+                    ));
                 }
-                return Err(loc.err(
-                    gspan.clone(),
-                    "cases.name",
-                    format!(
-                        "two cases are named `{cname}` (the first on line {}) with different parameters",
-                        case_lines[&cname]
-                    ),
-                ));
+                if !valid_name(&cname) {
+                    return Err(loc.err(
+                        gspan.clone(),
+                        "cases.name",
+                        format!("case name `{cname}` may use letters, digits, `.`, `_` and `-` only"),
+                    ));
+                }
+                if let Some(other) = cases.iter().find(|c| c.name == cname) {
+                    if other.params == p {
+                        continue;
+                    }
+                    return Err(loc.err(
+                        gspan.clone(),
+                        "cases.name",
+                        format!(
+                            "two cases are named `{cname}` (the first on line {}) with different parameters",
+                            case_lines[&cname]
+                        ),
+                    ));
+                }
+                if cases.iter().any(|c| c.params == p) {
+                    continue; // the same simulation under another name: run it once
+                }
+                case_lines.insert(cname.clone(), loc.line(gspan.start));
+                cases.push(Case { name: cname, scene: scene.name.to_string(), params: p });
             }
-            if cases.iter().any(|c| c.params == p) {
-                continue; // the same simulation under another name: run it once
-            }
-            case_lines.insert(cname.clone(), loc.line(gspan.start));
-            cases.push(Case { name: cname, scene: scene.name.to_string(), params: p });
         }
+        Ok(cases)
     }
 
-    let sel = |cases_: &[String], w: &RawParams| select(loc, scene, specs, cases_, w, vars, preset);
-    let mut figures = Vec::new();
-    let mut ids: BTreeMap<String, usize> = BTreeMap::new();
-    for f in &file.figures {
+    /// The cases a figure, table or bound selects.
+    fn select(&self, cases: &[String], where_: &RawParams) -> Result<Select, String> {
+        select(self.loc, self.scene, self.specs, cases, where_, self.vars, self.preset)
+    }
+
+    /// One figure, checked against the scene and the cases (`ids` holds the ids taken).
+    fn figure(
+        &self,
+        f: &Spanned<FigureFile>,
+        cases: &[Case],
+        ids: &mut BTreeMap<String, usize>,
+    ) -> Result<Figure, String> {
+        let Expand { loc, scene, specs, preset, .. } = *self;
         let span = f.span();
         let f = f.get_ref();
         let key = format!("figures.{}", f.id);
@@ -771,8 +829,8 @@ fn expand(
         if let Some(l) = ids.insert(f.id.clone(), loc.line(span.start)) {
             return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
         }
-        let select = sel(&f.cases, &f.where_)?;
-        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
+        let select = self.select(&f.cases, &f.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
         for l in &f.label {
             if !specs.iter().any(|s| s.name == l) {
                 return Err(loc.err(span, &key, format!("`label` names no parameter `{l}`")));
@@ -813,7 +871,7 @@ fn expand(
                     }
                     // A snapshot after the end time does not exist: the figure would
                     // silently show another time. Every preset is checked.
-                    let picked = select.pick(&cases);
+                    let picked = select.pick(cases);
                     if let Some(c) = picked
                         .iter()
                         .find(|c| matches!(c.params.0.get("tf"), Some(Value::Float(tf)) if *tf < t))
@@ -916,16 +974,16 @@ fn expand(
         }
         let lower_than = match (&f.lower, &f.higher) {
             (Some(a), Some(b)) => {
-                let a = sel(&a.cases, &a.where_)?;
-                let b = sel(&b.cases, &b.where_)?;
-                nonempty(loc, span.clone(), &format!("{key}.lower"), &a, &cases, preset)?;
-                nonempty(loc, span.clone(), &format!("{key}.higher"), &b, &cases, preset)?;
+                let a = self.select(&a.cases, &a.where_)?;
+                let b = self.select(&b.cases, &b.where_)?;
+                nonempty(loc, span.clone(), &format!("{key}.lower"), &a, cases, preset)?;
+                nonempty(loc, span.clone(), &format!("{key}.higher"), &b, cases, preset)?;
                 Some((a, b))
             }
             (None, None) => None,
             _ => return Err(loc.err(span, &key, "`lower` and `higher` go together")),
         };
-        figures.push(Figure {
+        Ok(Figure {
             id: f.id.clone(),
             kind,
             title: f.title.clone(),
@@ -939,18 +997,25 @@ fn expand(
             label: f.label.clone(),
             converges: f.converges,
             lower_than,
-        });
+        })
     }
-    let mut tables = Vec::new();
-    for t in &file.tables {
+
+    /// One table, checked against the scene and the cases (`ids` holds the ids taken).
+    fn table(
+        &self,
+        t: &Spanned<TableFile>,
+        cases: &[Case],
+        ids: &mut BTreeMap<String, usize>,
+    ) -> Result<Table, String> {
+        let Expand { loc, scene, specs, preset, .. } = *self;
         let span = t.span();
         let t = t.get_ref();
         let key = format!("tables.{}", t.id);
         if let Some(l) = ids.insert(t.id.clone(), loc.line(span.start)) {
             return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
         }
-        let select = sel(&t.cases, &t.where_)?;
-        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
+        let select = self.select(&t.cases, &t.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
         for m in &t.metrics {
             check_metric(loc, span.clone(), &key, scene, m)?;
         }
@@ -959,17 +1024,20 @@ fn expand(
                 return Err(loc.err(span, &key, format!("`columns` names no parameter `{c}`")));
             }
         }
-        tables.push(Table {
+        Ok(Table {
             id: t.id.clone(),
             title: t.title.clone(),
             caption: t.caption.clone(),
             select,
             columns: t.columns.clone(),
             metrics: t.metrics.clone(),
-        });
+        })
     }
-    let mut bounds = Vec::new();
-    for b in &file.bounds {
+
+    /// One bound, checked against the scene and the cases; `None` if it does not hold in
+    /// this preset.
+    fn bound(&self, b: &Spanned<BoundFile>, cases: &[Case]) -> Result<Option<Bound>, String> {
+        let Expand { loc, file, scene, preset, .. } = *self;
         let span = b.span();
         let b = b.get_ref();
         let key = format!("bounds.{}", b.metric);
@@ -993,32 +1061,19 @@ fn expand(
             }
         }
         if !presets.iter().any(|p| p == preset) {
-            continue;
+            return Ok(None);
         }
-        let select = sel(&b.cases, &b.where_)?;
-        nonempty(loc, span.clone(), &key, &select, &cases, preset)?;
-        bounds.push(Bound {
+        let select = self.select(&b.cases, &b.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
+        Ok(Some(Bound {
             metric: b.metric.clone(),
             select,
             max: b.max,
             min: b.min,
             presets,
             line: loc.line(span.start),
-        });
+        }))
     }
-    Ok(Problem {
-        name: name.to_string(),
-        path: loc.path.to_path_buf(),
-        title: file.title.clone(),
-        description: file.description.clone(),
-        scene,
-        preset: preset.to_string(),
-        other_presets: Vec::new(),
-        cases,
-        figures,
-        tables,
-        bounds,
-    })
 }
 
 /// Reads and checks the published points of a `profile` figure: the file exists under
