@@ -306,23 +306,7 @@ fn run(cli: Cli) -> ExitCode {
             if code != 0 {
                 return ExitCode::from(code);
             }
-            println!("scenes:");
-            for s in scenes::SCENES {
-                println!("{} ({}D): {}", s.name, s.dim, s.about);
-                let params = (s.params)();
-                // Columns as wide as the scene's widest entry, so that long names and
-                // choice lists keep the help text aligned.
-                let rows: Vec<[String; 4]> = params
-                    .iter()
-                    .map(|p| [p.name.to_string(), p.kind_name(), p.default.to_string(), p.help.to_string()])
-                    .collect();
-                let width = |c: usize| rows.iter().map(|r| r[c].len()).max().unwrap_or(0);
-                let (w0, w1, w2) = (width(0), width(1), width(2));
-                for [name, kind, default, help] in &rows {
-                    println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
-                }
-                println!("    metrics: {}", s.metrics.join(", "));
-            }
+            print_scenes();
             ExitCode::SUCCESS
         }
         Command::Run { problem, args } => ExitCode::from(commands::run(
@@ -352,57 +336,12 @@ fn run(cli: Cli) -> ExitCode {
             progress_file,
             checkpoint_every,
             stop_after_steps,
-        } => {
-            let entry = match scenes::find(&scene) {
-                Ok(e) => e,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(2);
-                }
-            };
-            let params = match entry.params_from_sets(&sets) {
-                Ok(p) => p,
-                Err(e) => {
-                    eprintln!("error: {e}");
-                    return ExitCode::from(2);
-                }
-            };
-            let opts =
-                harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps };
-            match harness::run(entry, &params, &out, &opts) {
-                Ok(s) => match s.status {
-                    sphrepro::solver::output::summary::Status::Completed => {
-                        if !quiet {
-                            eprintln!(
-                                "completed: {} steps, {:.2} s, {:.3e} particle-steps/s",
-                                s.steps, s.wall_seconds, s.particle_steps_per_second
-                            );
-                            for (k, v) in &s.metrics {
-                                eprintln!("  {k} = {v:.6e}");
-                            }
-                        }
-                        ExitCode::SUCCESS
-                    }
-                    _ => {
-                        eprintln!(
-                            "diverged at step {} (t = {}): {}",
-                            s.step.unwrap_or(s.steps),
-                            s.final_time,
-                            s.reason.as_deref().unwrap_or("")
-                        );
-                        ExitCode::from(3)
-                    }
-                },
-                Err(harness::RunError::Input(e)) => {
-                    eprintln!("error: {e}");
-                    ExitCode::from(2)
-                }
-                Err(harness::RunError::Failed(e)) => {
-                    eprintln!("failed: {e}");
-                    ExitCode::from(1)
-                }
-            }
-        }
+        } => simulate(
+            &scene,
+            &sets,
+            &out,
+            harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
+        ),
         Command::Bench(args) => run_bench(args),
         Command::BenchCase { variant, nx, steps, kernel } => {
             print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel))
@@ -410,6 +349,72 @@ fn run(cli: Cli) -> ExitCode {
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => print_json(
             bench::run_interleaved(&variants, nx, &bench_threads, steps, rounds, BENCH_WARMUP, &kernel),
         ),
+    }
+}
+
+/// `simulate`: one run of `scene` into `out`; exit 0 when it completes, 3 when it diverges
+/// (a result, reported as such), 2 on bad input and 1 when the run fails.
+fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::RunOptions) -> ExitCode {
+    let (entry, params) = match scenes::find(scene).and_then(|e| Ok((e, e.params_from_sets(sets)?))) {
+        Ok(found) => found,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::from(2);
+        }
+    };
+    match harness::run(entry, &params, out, &opts) {
+        Ok(s) => match s.status {
+            sphrepro::solver::output::summary::Status::Completed => {
+                if !opts.quiet {
+                    eprintln!(
+                        "completed: {} steps, {:.2} s, {:.3e} particle-steps/s",
+                        s.steps, s.wall_seconds, s.particle_steps_per_second
+                    );
+                    for (k, v) in &s.metrics {
+                        eprintln!("  {k} = {v:.6e}");
+                    }
+                }
+                ExitCode::SUCCESS
+            }
+            _ => {
+                eprintln!(
+                    "diverged at step {} (t = {}): {}",
+                    s.step.unwrap_or(s.steps),
+                    s.final_time,
+                    s.reason.as_deref().unwrap_or("")
+                );
+                ExitCode::from(3)
+            }
+        },
+        Err(harness::RunError::Input(e)) => {
+            eprintln!("error: {e}");
+            ExitCode::from(2)
+        }
+        Err(harness::RunError::Failed(e)) => {
+            eprintln!("failed: {e}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// The scenes, each with its parameters (name, kind, default, help) and metrics.
+fn print_scenes() {
+    println!("scenes:");
+    for s in scenes::SCENES {
+        println!("{} ({}D): {}", s.name, s.dim, s.about);
+        let params = (s.params)();
+        // Columns as wide as the scene's widest entry, so that long names and
+        // choice lists keep the help text aligned.
+        let rows: Vec<[String; 4]> = params
+            .iter()
+            .map(|p| [p.name.to_string(), p.kind_name(), p.default.to_string(), p.help.to_string()])
+            .collect();
+        let width = |c: usize| rows.iter().map(|r| r[c].len()).max().unwrap_or(0);
+        let (w0, w1, w2) = (width(0), width(1), width(2));
+        for [name, kind, default, help] in &rows {
+            println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
+        }
+        println!("    metrics: {}", s.metrics.join(", "));
     }
 }
 
