@@ -491,7 +491,8 @@ pub fn parse_with(
     }
     let (mut out, mut others) = (None, Vec::new());
     for (pname, vars) in &file.presets {
-        let p = expand(&loc, &file, scene, &specs, &name, pname, vars.get_ref())?;
+        let x = Expand { loc: &loc, file: &file, scene, specs: &specs, preset: pname, vars: vars.get_ref() };
+        let p = x.problem(&name)?;
         if pname == preset {
             out = Some(p);
         } else {
@@ -656,7 +657,6 @@ fn check_metric(
     }
 }
 
-#[allow(clippy::too_many_arguments)]
 /// What expanding one problem file has at hand: where its errors point, the file, its scene
 /// (and the scene's parameters), the preset and the file's variables.
 struct Expand<'a> {
@@ -668,40 +668,38 @@ struct Expand<'a> {
     vars: &'a RawParams,
 }
 
-fn expand(
-    loc: &Loc,
-    file: &ProblemFile,
-    scene: &'static SceneEntry,
-    specs: &[Spec],
-    name: &str,
-    preset: &str,
-    vars: &RawParams,
-) -> Result<Problem, String> {
-    let x = Expand { loc, file, scene, specs, preset, vars };
-    let cases = x.cases()?;
-    // Figures and tables share one space of ids.
-    let mut ids: BTreeMap<String, usize> = BTreeMap::new();
-    let figures =
-        file.figures.iter().map(|f| x.figure(f, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
-    let tables = file.tables.iter().map(|t| x.table(t, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
-    let bounds =
-        file.bounds.iter().filter_map(|b| x.bound(b, &cases).transpose()).collect::<Result<Vec<_>, _>>()?;
-    Ok(Problem {
-        name: name.to_string(),
-        path: loc.path.to_path_buf(),
-        title: file.title.clone(),
-        description: file.description.clone(),
-        scene,
-        preset: preset.to_string(),
-        other_presets: Vec::new(),
-        cases,
-        figures,
-        tables,
-        bounds,
-    })
-}
-
 impl Expand<'_> {
+    /// The problem `name` in this preset: its cases, then its figures, tables and bounds,
+    /// each checked against the scene and the cases.
+    fn problem(&self, name: &str) -> Result<Problem, String> {
+        let file = self.file;
+        let cases = self.cases()?;
+        // Figures and tables share one space of ids.
+        let mut ids: BTreeMap<String, usize> = BTreeMap::new();
+        let figures =
+            file.figures.iter().map(|f| self.figure(f, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
+        let tables =
+            file.tables.iter().map(|t| self.table(t, &cases, &mut ids)).collect::<Result<Vec<_>, _>>()?;
+        let bounds = file
+            .bounds
+            .iter()
+            .filter_map(|b| self.bound(b, &cases).transpose())
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Problem {
+            name: name.to_string(),
+            path: self.loc.path.to_path_buf(),
+            title: file.title.clone(),
+            description: file.description.clone(),
+            scene: self.scene,
+            preset: self.preset.to_string(),
+            other_presets: Vec::new(),
+            cases,
+            figures,
+            tables,
+            bounds,
+        })
+    }
+
     /// The cases of the preset: the problem-wide parameters over the scene's defaults, then
     /// each group's, its grid expanded (a simulation named twice, or named alike with
     /// other parameters, is caught here).
@@ -823,12 +821,7 @@ impl Expand<'_> {
         let span = f.span();
         let f = f.get_ref();
         let key = format!("figures.{}", f.id);
-        if !valid_name(&f.id) {
-            return Err(loc.err(span, &key, "an id may use letters, digits, `.`, `_` and `-` only"));
-        }
-        if let Some(l) = ids.insert(f.id.clone(), loc.line(span.start)) {
-            return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
-        }
+        claim_id(loc, span.clone(), &key, &f.id, ids)?;
         let select = self.select(&f.cases, &f.where_)?;
         nonempty(loc, span.clone(), &key, &select, cases, preset)?;
         for l in &f.label {
@@ -1011,9 +1004,7 @@ impl Expand<'_> {
         let span = t.span();
         let t = t.get_ref();
         let key = format!("tables.{}", t.id);
-        if let Some(l) = ids.insert(t.id.clone(), loc.line(span.start)) {
-            return Err(loc.err(span, &key, format!("a figure or table on line {l} has the same id")));
-        }
+        claim_id(loc, span.clone(), &key, &t.id, ids)?;
         let select = self.select(&t.cases, &t.where_)?;
         nonempty(loc, span.clone(), &key, &select, cases, preset)?;
         for m in &t.metrics {
@@ -1074,6 +1065,25 @@ impl Expand<'_> {
             line: loc.line(span.start),
         }))
     }
+}
+
+/// Takes `id` for a figure or a table: a name their files can carry (it becomes
+/// `figures/ID.png` or `tables/ID.md`, so no path), not taken by another figure or table of
+/// the problem (`ids`: each id taken, with its line).
+fn claim_id(
+    loc: &Loc,
+    span: std::ops::Range<usize>,
+    key: &str,
+    id: &str,
+    ids: &mut BTreeMap<String, usize>,
+) -> Result<(), String> {
+    if !valid_name(id) {
+        return Err(loc.err(span, key, "an id may use letters, digits, `.`, `_` and `-` only"));
+    }
+    if let Some(l) = ids.insert(id.to_string(), loc.line(span.start)) {
+        return Err(loc.err(span, key, format!("a figure or table on line {l} has the same id")));
+    }
+    Ok(())
 }
 
 /// Reads and checks the published points of a `profile` figure: the file exists under
@@ -1257,6 +1267,20 @@ max = 1.0
         assert!(e.contains("`scheme` = edac") && e.contains("case `"), "{e}");
         // Switched off, it passes.
         assert!(p(&GOOD.replace("grid = { scheme", "params = { pst = \"none\" }\ngrid = { scheme")).is_ok());
+        // Figure and table ids name files: a path is refused, and so is an id taken twice.
+        let table = |id: &str| {
+            format!("{GOOD}[[tables]]\nid = \"{id}\"\ntitle = \"t\"\nmetrics = [\"l1_velocity_final\"]\n")
+        };
+        assert!(p(&table("t1")).is_ok());
+        let e = p(&table("../t1")).unwrap_err();
+        assert!(
+            e.starts_with("x.toml:") && e.contains("`tables.../t1`") && e.contains("an id may use"),
+            "{e}"
+        );
+        let e = p(&table("f1")).unwrap_err();
+        assert!(e.contains("`tables.f1`") && e.contains("has the same id"), "{e}");
+        let e = p(&GOOD.replace("id = \"f1\"", "id = \"a/f1\"")).unwrap_err();
+        assert!(e.contains("`figures.a/f1`") && e.contains("an id may use"), "{e}");
     }
 
     /// A profile figure appended to [`GOOD`], with a reference file in
