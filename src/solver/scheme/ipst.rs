@@ -22,7 +22,7 @@ pub(super) struct IpstWork<const D: usize> {
     /// The moved positions of the current sweep, and of the next.
     x_shift: Vec<Vector<D>>,
     x_next: Vec<Vector<D>>,
-    pub(super) slabs: Slabs,
+    slabs: Slabs,
     slab_work: Vec<IpstSlab<D>>,
     /// Each particle's sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
     sums: Vec<(Vector<D>, f64)>,
