@@ -380,6 +380,9 @@ impl std::fmt::Debug for Problem {
     }
 }
 
+/// A byte range of a problem file, where an error points.
+type Span = std::ops::Range<usize>;
+
 /// Where an error is: file and line.
 struct Loc<'a> {
     path: &'a Path,
@@ -832,132 +835,19 @@ impl Expand<'_> {
         if let Some(m) = &f.metric {
             check_metric(loc, span.clone(), &key, scene, m)?;
         }
-        let need = |what: &str, v: &Option<String>| {
-            v.clone().ok_or_else(|| loc.err(span.clone(), &key, format!("kind `{}` needs `{what}`", f.kind)))
-        };
-        let kind = match f.kind.as_str() {
-            "timeseries" => {
-                let y = need("y", &f.y)?;
-                for (what, c) in [("y", Some(&y)), ("exact", f.exact.as_ref())] {
-                    if let Some(c) = c.filter(|c| !scene.columns.contains(&c.as_str())) {
-                        return Err(loc.err(
-                            span,
-                            &format!("{key}.{what}"),
-                            format!(
-                                "scene `{}` has no time-series column `{c}`; its columns: {}",
-                                scene.name,
-                                scene.columns.join(", ")
-                            ),
-                        ));
-                    }
-                }
-                FigureKind::Timeseries { y, exact: f.exact.clone() }
-            }
-            "particles" => {
-                if let Some(t) = f.time {
-                    if !(t.is_finite() && t >= 0.0) {
-                        return Err(loc.err(
-                            span,
-                            &format!("{key}.time"),
-                            format!("`{t}` is not a time >= 0"),
-                        ));
-                    }
-                    // A snapshot after the end time does not exist: the figure would
-                    // silently show another time. Every preset is checked.
-                    let picked = select.pick(cases);
-                    if let Some(c) = picked
-                        .iter()
-                        .find(|c| matches!(c.params.0.get("tf"), Some(Value::Float(tf)) if *tf < t))
-                    {
-                        return Err(loc.err(
-                            span,
-                            &format!("{key}.time"),
-                            format!(
-                                "t = {t} is after the end time tf = {} of case `{}` in preset `{preset}`",
-                                c.params.0["tf"], c.name
-                            ),
-                        ));
-                    }
-                }
-                if let Some(a) = &f.arrows {
-                    if a.is_empty() || a.contains(['"', '<', '>']) {
-                        return Err(loc.err(
-                            span,
-                            &format!("{key}.arrows"),
-                            format!("`{a}` is not a point array name"),
-                        ));
-                    }
-                }
-                FigureKind::Particles {
-                    field: need("field", &f.field)?,
-                    time: f.time,
-                    arrows: f.arrows.clone(),
-                }
-            }
-            "trade" => {
-                need("metric", &f.metric)?;
-                let x = need("x", &f.x)?;
-                if !specs.iter().any(|s| s.name == x) {
-                    return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
-                }
-                FigureKind::Trade { x, spacing: f.x_spacing }
-            }
-            "stability" => {
-                need("metric", &f.metric)?;
-                let x = need("x", &f.x)?;
-                if !specs.iter().any(|s| s.name == x) {
-                    return Err(loc.err(span, &key, format!("`x` names no parameter `{x}`")));
-                }
-                FigureKind::Stability {
-                    x,
-                    max: f.max.ok_or_else(|| loc.err(span.clone(), &key, "kind `stability` needs `max`"))?,
-                }
-            }
-            "profile" => {
-                let file_name = need("file", &f.file)?;
-                if !valid_name(&file_name) || file_name.starts_with('.') {
-                    return Err(loc.err(
-                        span,
-                        &format!("{key}.file"),
-                        format!("`{file_name}` must be a file name in the case folder (letters, digits, `.`, `_`, `-`)"),
-                    ));
-                }
-                let reference = match &f.reference {
-                    Some(r) => Some(reference(loc, r.span(), &key, r.get_ref())?),
-                    None => None,
-                };
-                FigureKind::Profile { file: file_name, x: need("x", &f.x)?, y: need("y", &f.y)?, reference }
-            }
-            other => {
-                return Err(loc.err(
-                    span,
-                    &key,
-                    format!(
-                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability, profile"
-                    ),
-                ))
-            }
-        };
-        for (k, set) in [
-            ("file", f.file.is_some()),
-            ("reference", f.reference.is_some()),
-            ("x_label", f.x_label.is_some()),
+        let kind = self.figure_kind(f, span.clone(), &key, &select, cases)?;
+        // Keys that only one kind reads: set on another, they would be silently ignored.
+        for (k, set, only) in [
+            ("file", f.file.is_some(), "profile"),
+            ("reference", f.reference.is_some(), "profile"),
+            ("x_label", f.x_label.is_some(), "profile"),
+            ("time", f.time.is_some(), "particles"),
+            ("arrows", f.arrows.is_some(), "particles"),
+            ("x_spacing", f.x_spacing, "trade"),
         ] {
-            if set && !matches!(kind, FigureKind::Profile { .. }) {
-                return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `profile` takes `{k}`")));
+            if set && f.kind != only {
+                return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `{only}` takes `{k}`")));
             }
-        }
-        for (k, set) in [("time", f.time.is_some()), ("arrows", f.arrows.is_some())] {
-            if set && !matches!(kind, FigureKind::Particles { .. }) {
-                return Err(loc.err(
-                    span,
-                    &format!("{key}.{k}"),
-                    format!("only kind `particles` takes `{k}`"),
-                ));
-            }
-        }
-        if f.x_spacing && !matches!(kind, FigureKind::Trade { .. }) {
-            return Err(loc.err(span, &format!("{key}.x_spacing"), "only kind `trade` takes `x_spacing`"));
         }
         if (f.converges || f.lower.is_some()) && f.metric.is_none() {
             return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
@@ -991,6 +881,143 @@ impl Expand<'_> {
             converges: f.converges,
             lower_than,
         })
+    }
+
+    /// What figure `f` draws (its `kind` and the keys that kind needs), checked.
+    fn figure_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        select: &Select,
+        cases: &[Case],
+    ) -> Result<FigureKind, String> {
+        let need = |what: &str, v: &Option<String>| {
+            v.clone()
+                .ok_or_else(|| self.loc.err(span.clone(), key, format!("kind `{}` needs `{what}`", f.kind)))
+        };
+        Ok(match f.kind.as_str() {
+            "timeseries" => self.timeseries_kind(f, span.clone(), key, need("y", &f.y)?)?,
+            "particles" => {
+                self.particles_kind(f, span.clone(), key, select, cases, need("field", &f.field)?)?
+            }
+            "trade" => {
+                need("metric", &f.metric)?;
+                FigureKind::Trade {
+                    x: self.swept(span.clone(), key, need("x", &f.x)?)?,
+                    spacing: f.x_spacing,
+                }
+            }
+            "stability" => {
+                need("metric", &f.metric)?;
+                let x = self.swept(span.clone(), key, need("x", &f.x)?)?;
+                let max =
+                    f.max.ok_or_else(|| self.loc.err(span.clone(), key, "kind `stability` needs `max`"))?;
+                FigureKind::Stability { x, max }
+            }
+            "profile" => {
+                let file_name = need("file", &f.file)?;
+                if !valid_name(&file_name) || file_name.starts_with('.') {
+                    return Err(self.loc.err(
+                        span.clone(),
+                        &format!("{key}.file"),
+                        format!("`{file_name}` must be a file name in the case folder (letters, digits, `.`, `_`, `-`)"),
+                    ));
+                }
+                let reference = match &f.reference {
+                    Some(r) => Some(reference(self.loc, r.span(), key, r.get_ref())?),
+                    None => None,
+                };
+                FigureKind::Profile { file: file_name, x: need("x", &f.x)?, y: need("y", &f.y)?, reference }
+            }
+            other => {
+                return Err(self.loc.err(
+                    span.clone(),
+                    key,
+                    format!(
+                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability, profile"
+                    ),
+                ))
+            }
+        })
+    }
+
+    /// A `timeseries` figure of column `y`: it and the exact column are columns the scene
+    /// writes.
+    fn timeseries_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        y: String,
+    ) -> Result<FigureKind, String> {
+        let scene = self.scene;
+        for (what, c) in [("y", Some(&y)), ("exact", f.exact.as_ref())] {
+            if let Some(c) = c.filter(|c| !scene.columns.contains(&c.as_str())) {
+                return Err(self.loc.err(
+                    span,
+                    &format!("{key}.{what}"),
+                    format!(
+                        "scene `{}` has no time-series column `{c}`; its columns: {}",
+                        scene.name,
+                        scene.columns.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(FigureKind::Timeseries { y, exact: f.exact.clone() })
+    }
+
+    /// A `particles` figure of point array `field`: its `time` is one every selected case
+    /// reaches, and `arrows` a point array name.
+    fn particles_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        select: &Select,
+        cases: &[Case],
+        field: String,
+    ) -> Result<FigureKind, String> {
+        let (loc, preset) = (self.loc, self.preset);
+        if let Some(t) = f.time {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(loc.err(span, &format!("{key}.time"), format!("`{t}` is not a time >= 0")));
+            }
+            // A snapshot after the end time does not exist: the figure would silently show
+            // another time. Every preset is checked.
+            let picked = select.pick(cases);
+            if let Some(c) =
+                picked.iter().find(|c| matches!(c.params.0.get("tf"), Some(Value::Float(tf)) if *tf < t))
+            {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.time"),
+                    format!(
+                        "t = {t} is after the end time tf = {} of case `{}` in preset `{preset}`",
+                        c.params.0["tf"], c.name
+                    ),
+                ));
+            }
+        }
+        if let Some(a) = &f.arrows {
+            if a.is_empty() || a.contains(['"', '<', '>']) {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.arrows"),
+                    format!("`{a}` is not a point array name"),
+                ));
+            }
+        }
+        Ok(FigureKind::Particles { field, time: f.time, arrows: f.arrows.clone() })
+    }
+
+    /// The swept parameter `x` of a `trade` or `stability` figure: one the scene has.
+    fn swept(&self, span: Span, key: &str, x: String) -> Result<String, String> {
+        if !self.specs.iter().any(|s| s.name == x) {
+            return Err(self.loc.err(span, key, format!("`x` names no parameter `{x}`")));
+        }
+        Ok(x)
     }
 
     /// One table, checked against the scene and the cases (`ids` holds the ids taken).
@@ -1281,6 +1308,48 @@ max = 1.0
         assert!(e.contains("`tables.f1`") && e.contains("has the same id"), "{e}");
         let e = p(&GOOD.replace("id = \"f1\"", "id = \"a/f1\"")).unwrap_err();
         assert!(e.contains("`figures.a/f1`") && e.contains("an id may use"), "{e}");
+    }
+
+    /// Each figure kind's own keys: what it needs, what it checks, and keys of another kind
+    /// refused rather than ignored.
+    #[test]
+    fn figure_kinds_check_their_keys() {
+        let kind = |k: &str, extra: &str| {
+            GOOD.replace("kind = \"timeseries\"", &format!("kind = \"{k}\"{extra}"))
+                .replace("y = \"u_max\"\n", "")
+        };
+        for k in ["trade", "stability"] {
+            let e = p(&kind(k, "")).unwrap_err();
+            assert!(e.starts_with("x.toml:") && e.contains("`figures.f1`") && e.contains("needs `x`"), "{e}");
+            let e = p(&kind(k, "\nx = \"nz\"\nmax = 0.1")).unwrap_err();
+            assert!(e.contains("`x` names no parameter `nz`"), "{e}");
+        }
+        assert!(p(&kind("trade", "\nx = \"nx\"")).is_ok());
+        let e = p(&kind("stability", "\nx = \"nx\"")).unwrap_err();
+        assert!(e.contains("kind `stability` needs `max`"), "{e}");
+        assert!(p(&kind("stability", "\nx = \"nx\"\nmax = 0.1")).is_ok());
+        let e = p(&kind("particles", "")).unwrap_err();
+        assert!(e.contains("needs `field`"), "{e}");
+        assert!(p(&kind("particles", "\nfield = \"p\"\ntime = 0.01")).is_ok());
+        let e = p(&kind("particles", "\nfield = \"p\"\ntime = 0.5")).unwrap_err();
+        assert!(e.contains("`figures.f1.time`") && e.contains("after the end time"), "{e}");
+        let e = p(&kind("particles", "\nfield = \"p\"\ntime = -1.0")).unwrap_err();
+        assert!(e.contains("not a time >= 0"), "{e}");
+        let e = p(&kind("particles", "\nfield = \"p\"\narrows = \"<n>\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.arrows`"), "{e}");
+        let e = p(&GOOD.replace("y = \"u_max\"", "y = \"vorticity\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.y`") && e.contains("no time-series column `vorticity`"), "{e}");
+        for (extra, only) in [
+            ("time = 0.01", "particles"),
+            ("arrows = \"n\"", "particles"),
+            ("x_spacing = true", "trade"),
+            ("x_label = \"u\"", "profile"),
+        ] {
+            let e = p(&GOOD.replace("y = \"u_max\"", &format!("y = \"u_max\"\n{extra}"))).unwrap_err();
+            assert!(e.contains(&format!("only kind `{only}` takes")), "{extra}: {e}");
+        }
+        let e = p(&kind("bars", "")).unwrap_err();
+        assert!(e.contains("unknown kind `bars`") && e.contains("timeseries, particles"), "{e}");
     }
 
     /// A profile figure appended to [`GOOD`], with a reference file in
