@@ -226,6 +226,10 @@ enum Command {
         steps: u64,
         #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
+        /// The step's gather passes one after the other, not as a wavefront over tiles
+        /// (the same results; for timing the two).
+        #[arg(long)]
+        sweeps: bool,
     },
     /// The cases of one resolution timed side by side in this process (used by
     /// `bench --interleave`).
@@ -343,8 +347,8 @@ fn run(cli: Cli) -> ExitCode {
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
         Command::Bench(args) => run_bench(args),
-        Command::BenchCase { variant, nx, steps, kernel } => {
-            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel))
+        Command::BenchCase { variant, nx, steps, kernel, sweeps } => {
+            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel, !sweeps))
         }
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => print_json(
             bench::run_interleaved(&variants, nx, &bench_threads, steps, rounds, BENCH_WARMUP, &kernel),

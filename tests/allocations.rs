@@ -63,6 +63,8 @@ fn steps_allocate_nothing_once_warm() {
         (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=edac"]),
         (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=ctvf", "pst=sun"]),
         (scenes::find("taylor_green").unwrap(), &["nx=30", "scheme=ctvf", "pst=ipst"]),
+        // 65 536 particles: sixteen tiles, the step runs as a wavefront.
+        (scenes::find("taylor_green").unwrap(), &["nx=256", "scheme=edac"]),
         (scenes::find("cavity").unwrap(), &["nx=20"]),
         (scenes::find("hydrostatic_tank").unwrap(), &["dx=0.1"]),
         (scenes::find("dam_break").unwrap(), &["dx=0.1", "pst=ipst"]),

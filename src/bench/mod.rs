@@ -233,8 +233,14 @@ fn status_kb(field: &str) -> u64 {
 /// Taylor-Green flow sits there (measured at nx = 50 and 100: from t = 0.09 on, every step
 /// makes the 10 moves), while the first steps of a run barely iterate, so timing those would
 /// understate its cost.
-/// It is returned after `warmup` untimed steps.
-fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Result<Simulation<2>, String> {
+/// It is returned after `warmup` untimed steps; `wavefront` as [`Simulation::set_wavefront`].
+fn case_simulation(
+    variant: &str,
+    nx: usize,
+    kernel: &str,
+    warmup: u64,
+    wavefront: bool,
+) -> Result<Simulation<2>, String> {
     let (_, scheme, pst) = VARIANTS
         .iter()
         .find(|v| v.0 == variant)
@@ -248,6 +254,7 @@ fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Resul
     }
     let p = taylor_green::params_from(&sets)?;
     let mut sim = taylor_green::simulation::<2>(&p)?;
+    sim.set_wavefront(wavefront);
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
@@ -358,9 +365,10 @@ pub fn run_case(
     steps: u64,
     warmup: u64,
     kernel: &str,
+    wavefront: bool,
 ) -> Result<BenchResult, String> {
     let rss0 = status_kb("VmRSS:") * 1024;
-    let mut sim = case_simulation(variant, nx, kernel, warmup)?;
+    let mut sim = case_simulation(variant, nx, kernel, warmup, wavefront)?;
     let mut timed = Timed::default();
     timed.steps(&mut sim, steps)?;
     let n = sim.fluid().len();
@@ -412,10 +420,10 @@ pub fn run_interleaved(
     let mut sims = Vec::new();
     for v in variants {
         let rss0 = status_kb("VmRSS:") * 1024;
-        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
+        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup, true))?;
         let grown = (status_kb("VmRSS:") * 1024).saturating_sub(rss0);
         let copies = (1..most_copies)
-            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup)))
+            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup, true)))
             .collect::<Result<Vec<_>, _>>()?;
         sims.push((sim, copies, grown));
     }

@@ -6,8 +6,9 @@ use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
 use crate::solver::scheme::{
-    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, DensityModel, FluidPasses,
-    FluidScheme, KernelList, PressureModel, Shifting, SurfaceFields, SurfacePressure, WallSet,
+    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, wavefront_applies,
+    DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, Shifting, StepBodies, SurfaceFields,
+    SurfacePressure, WallSet, Wavefront,
 };
 use crate::solver::{warm, LIGHT_LOOP_LEN};
 use rayon::prelude::*;
@@ -147,6 +148,10 @@ pub struct Simulation<const D: usize> {
     /// The fluid's share of the summation density, summed as the list is built.
     fluid_density: Vec<f64>,
     passes: FluidPasses<D>,
+    /// The tiles of the wavefront step, whether it may run, and the steps it ran.
+    wave: Wavefront,
+    wavefront: bool,
+    wavefront_steps: u64,
     /// Time per phase of the step, summed over the run.
     pub times: PhaseTimes,
 }
@@ -184,6 +189,9 @@ impl<const D: usize> Simulation<D> {
             neighbours: KernelList::new(),
             fluid_density: Vec::new(),
             passes: FluidPasses::new(),
+            wave: Wavefront::new(),
+            wavefront: true,
+            wavefront_steps: 0,
             times: PhaseTimes::default(),
         };
         sim.rebuild();
@@ -249,12 +257,53 @@ impl<const D: usize> Simulation<D> {
     /// Wraps positions into the box, sorts the particles by cell and lists neighbours;
     /// then the wall pressure and velocities from the fluid.
     fn rebuild(&mut self) {
+        self.rebin();
+        self.relist();
+    }
+
+    /// Wraps positions into the box and sorts the particles by cell.
+    fn rebin(&mut self) {
         let (domain, fluid) = (&self.domain, &mut self.state.fluid);
         fluid.x.par_iter_mut().with_min_len(LIGHT_LOOP_LEN).for_each(|x| domain.wrap(x));
         self.cells.update(&fluid.x);
         fluid.reorder(self.cells.order());
         self.cells.mark_reordered();
-        self.relist();
+    }
+
+    /// Whether the step's gather passes may run as a wavefront over tiles
+    /// ([`Wavefront`]); on by default. Off, they run one after the other, with the same
+    /// results bit for bit (for timing the two).
+    pub fn set_wavefront(&mut self, on: bool) {
+        self.wavefront = on;
+    }
+
+    /// The listing, summation density, pass A over `dt` and pass B of a step as a
+    /// wavefront, if the scheme and the body allow one ([`Wavefront`]); returns whether it
+    /// ran.
+    fn wavefront_step(&mut self, dt: f64, dt_nominal: f64) -> bool {
+        let st = &mut self.state;
+        if !(self.wavefront
+            && self.time_settings.rate_positions == RatePositions::End
+            && wavefront_applies(&st.scheme, self.walls.is_some(), self.surface.is_some())
+            && self.wave.plan(&self.cells, st.fluid.len()))
+        {
+            return false;
+        }
+        let bodies = StepBodies {
+            fluid: &mut st.fluid,
+            cells: &self.cells,
+            kernel: &self.kernel,
+            list: &mut self.neighbours,
+            fluid_density: &mut self.fluid_density,
+            scheme: &st.scheme,
+            rates: &mut st.rates,
+        };
+        let t = self.passes.wavefront_step(&mut self.wave, bodies, dt, dt_nominal);
+        self.times.neighbours += t.list;
+        self.times.pressure += t.pressure;
+        self.times.accelerations += t.accelerations;
+        self.wavefront_steps += 1;
+        true
     }
 
     /// The neighbour lists from the current binning, and the wall extrapolation.
@@ -329,13 +378,20 @@ impl<const D: usize> Simulation<D> {
             &mut st.rates,
             dt_nominal,
         );
-        let clock = lap(clock, &mut self.times.accelerations);
+        lap(clock, &mut self.times.accelerations);
+        self.homogenise(dt_nominal, next_step);
+    }
+
+    /// IPST's pass (eqs. 37-41), if the scheme shifts with it, after pass B.
+    fn homogenise(&mut self, dt_nominal: f64, next_step: u64) {
+        let clock = std::time::Instant::now();
+        let (st, walls) = (&mut self.state, self.walls.as_ref());
         st.ipst_iterations = self.passes.ipst(
             &st.fluid,
             &self.neighbours,
             &self.cells,
             walls,
-            surface,
+            self.surface.as_ref(),
             &self.kernel,
             &st.scheme,
             &mut st.rates,
@@ -386,21 +442,28 @@ impl<const D: usize> Simulation<D> {
             integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
-        self.rebuild();
-        let mut clock = lap(clock, &mut self.times.neighbours);
-        if self.state.scheme.density == DensityModel::Summation {
-            let walls = self.walls.as_ref();
-            FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
-            clock = lap(clock, &mut self.times.density);
-        }
-        if rates_at == RatePositions::End {
-            self.update_density_and_pressure(dt);
-        }
-        // The walls follow the fluid's new pressure before the accelerations use it.
-        self.extrapolate_walls();
-        lap(clock, &mut self.times.pressure);
+        self.rebin();
+        lap(clock, &mut self.times.neighbours);
         // For the next step (its kick applies the homogenisation acceleration).
-        self.evaluate_accelerations(dt_nominal, self.state.steps + 1);
+        if self.wavefront_step(dt, dt_nominal) {
+            self.homogenise(dt_nominal, self.state.steps + 1);
+        } else {
+            let clock = std::time::Instant::now();
+            self.relist();
+            let mut clock = lap(clock, &mut self.times.neighbours);
+            if self.state.scheme.density == DensityModel::Summation {
+                let walls = self.walls.as_ref();
+                FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
+                clock = lap(clock, &mut self.times.density);
+            }
+            if rates_at == RatePositions::End {
+                self.update_density_and_pressure(dt);
+            }
+            // The walls follow the fluid's new pressure before the accelerations use it.
+            self.extrapolate_walls();
+            lap(clock, &mut self.times.pressure);
+            self.evaluate_accelerations(dt_nominal, self.state.steps + 1);
+        }
         let clock = std::time::Instant::now();
         let st = &mut self.state;
         integrator::kick(&mut st.fluid.u, &st.rates.du, dt);
@@ -525,7 +588,11 @@ mod tests {
     }
 
     fn vortex_with(rates_at: RatePositions, pst: Pst) -> Simulation<2> {
-        let n = 16;
+        vortex_sized(16, SchemeName::Ctvf, pst, rates_at)
+    }
+
+    /// The vortex on an `n` x `n` lattice with `scheme`.
+    fn vortex_sized(n: usize, scheme: SchemeName, pst: Pst, rates_at: RatePositions) -> Simulation<2> {
         let dx = 1.0 / n as f64;
         let mut init = FluidInit::<2>::default();
         for j in 0..n {
@@ -543,7 +610,7 @@ mod tests {
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
         let settings =
             FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
-        let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+        let scheme = scheme.fluid_scheme(&settings);
         let fluid = Fluid::new("fluid", dx, init, true).unwrap();
         let time = TimeSettings { rate_positions: rates_at, ..TimeSettings::new(0.25, 10.0, 1.0) };
         Simulation::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel, fluid, None, scheme, time).unwrap()
@@ -610,6 +677,45 @@ mod tests {
             let bits = |f: &Fluid<2>| f.by_id(&f.p).iter().map(|p| p.to_bits()).collect::<Vec<_>>();
             let same = bits(&probe.fluid) == bits(&sim.state.fluid);
             assert_eq!(same, at_start, "{rates_at:?}");
+        }
+    }
+
+    /// The wavefront step sums what the sweeps sum, in the same order: the same state, bit
+    /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one and on two threads. Tiles
+    /// of three chunks cut the 128 x 128 body into ten, so that the first and last meet
+    /// across the periodic edge and the list's storage is handed from tile to tile.
+    #[test]
+    fn the_wavefront_step_is_the_sweeps_bit_for_bit() {
+        let cases =
+            [(SchemeName::Edac, Pst::None), (SchemeName::Ctvf, Pst::Sun), (SchemeName::Ctvf, Pst::Ipst)];
+        for (scheme, pst) in cases {
+            let run = |wavefront: bool, threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| {
+                    let mut sim = vortex_sized(128, scheme, pst, RatePositions::End);
+                    sim.wave = Wavefront::with_limits(1, 4);
+                    sim.set_wavefront(wavefront);
+                    for _ in 0..4 {
+                        sim.step(f64::INFINITY).unwrap();
+                    }
+                    assert_eq!(sim.wavefront_steps, if wavefront { 4 } else { 0 }, "{scheme:?} {pst:?}");
+                    if wavefront {
+                        assert_eq!(sim.wave.tiles(), 10);
+                    }
+                    let f = &sim.state.fluid;
+                    let r = &sim.state.rates;
+                    let vectors = [&f.x, &f.u, &r.du, &r.a_c];
+                    let mut bits: Vec<u64> =
+                        [&f.rho, &f.p, &r.dp].iter().flat_map(|v| v.iter().map(|x| x.to_bits())).collect();
+                    bits.extend(
+                        vectors.iter().flat_map(|v| v.iter().flat_map(|x| x.iter().map(|c| c.to_bits()))),
+                    );
+                    bits
+                })
+            };
+            let sweeps = run(false, 1);
+            assert_eq!(run(true, 1), sweeps, "{scheme:?} {pst:?}, one thread");
+            assert_eq!(run(true, 2), sweeps, "{scheme:?} {pst:?}, two threads");
         }
     }
 }

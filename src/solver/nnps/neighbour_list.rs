@@ -12,7 +12,7 @@ use rayon::prelude::*;
 
 /// Particles per build task; the lists are stored per chunk so building allocates nothing
 /// once the chunks have grown, and the result does not depend on the thread count.
-const CHUNK: usize = 512;
+pub const CHUNK: usize = 512;
 /// Bits of an entry holding the neighbour index (the rest hold the image code).
 const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
@@ -230,17 +230,52 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         out: &mut [R],
         reduce: impl Fn(Listed<'_, P>) -> R + Sync,
     ) {
-        let n = points.len();
+        assert_eq!(out.len(), points.len(), "one reduction per point");
+        let chunks = self.begin(cells, points.len());
+        self.build_chunks(cells, points, payload, chunks, out, reduce);
+    }
+
+    /// Readies the list for a build over `n` points in [`CHUNK`]s: returns the chunks,
+    /// which [`build_chunks`](Self::build_chunks) then lists, in any number of calls. Until
+    /// every chunk is built, only the points of built chunks may be queried.
+    pub fn begin(&mut self, cells: &CellList<D>, n: usize) -> std::ops::Range<usize> {
         assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
-        assert_eq!(out.len(), n, "one reduction per point");
         self.set_shifts(cells);
         self.sources = n;
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
+        0..self.chunks.len()
+    }
+
+    /// Hands the storage of chunk `dead`, whose points will not be queried again before the
+    /// next build, to chunk `next`, about to be built (and `next`'s to `dead`): a build of
+    /// many chunks then writes into memory just read, still in cache, rather than into
+    /// memory last touched a build ago.
+    pub fn recycle(&mut self, dead: usize, next: usize) {
+        self.chunks.swap(dead, next);
+    }
+
+    /// Lists the points of `chunks` (after [`begin`](Self::begin)), as
+    /// [`build_reducing`](Self::build_reducing) lists all: `out` holds one reduction per
+    /// point of these chunks, from the first chunk's first point.
+    pub fn build_chunks<R: Send>(
+        &mut self,
+        cells: &CellList<D>,
+        points: &[Vector<D>],
+        payload: impl Fn(&[f64], &mut [P]) + Sync,
+        chunks: std::ops::Range<usize>,
+        out: &mut [R],
+        reduce: impl Fn(Listed<'_, P>) -> R + Sync,
+    ) {
+        let n = points.len();
+        assert_eq!(n, self.sources, "the points of `begin`");
+        assert_eq!(out.len(), (chunks.end * CHUNK).min(n) - chunks.start * CHUNK, "one reduction per point");
         let shifts = &self.shifts;
         let r2max = cells.radius2();
         let path = filter::Path::fastest();
-        self.chunks.par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
+        let first = chunks.start;
+        self.chunks[chunks].par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
             |(c, (chunk, out))| {
+                let c = first + c;
                 // The entries and payload keep their length (the room of the last build):
                 // they only grow, so that no point's room is zeroed before it is written.
                 chunk.start.clear();

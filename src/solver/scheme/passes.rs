@@ -69,12 +69,27 @@ pub fn build_kernel_list_summing_density<const D: usize>(
     k: &Kernel,
     rho: &mut Vec<f64>,
 ) {
-    let (k, m) = (k.scaled(fluid.h), &fluid.m);
     rho.resize(fluid.len(), 0.0);
-    nl.build_reducing(
+    let chunks = nl.begin(cells, fluid.len());
+    build_kernel_chunks_summing_density(nl, cells, fluid, k, chunks, rho);
+}
+
+/// As [`build_kernel_list_summing_density`] for the points of `chunks` only (after
+/// [`NeighbourList::begin`]), their densities in `rho` from the first chunk's first point.
+pub(super) fn build_kernel_chunks_summing_density<const D: usize>(
+    nl: &mut KernelList<D>,
+    cells: &CellList<D>,
+    fluid: &Fluid<D>,
+    k: &Kernel,
+    chunks: std::ops::Range<usize>,
+    rho: &mut [f64],
+) {
+    let (k, m) = (k.scaled(fluid.h), &fluid.m);
+    nl.build_chunks(
         cells,
         &fluid.x,
         |r2, out| kernel_payload(&k, r2, out),
+        chunks,
         rho,
         |pairs| pairs.iter().fold(0.0, |s, (j, kw)| s + m[j] * kw.w),
     );
@@ -133,7 +148,7 @@ fn gather_wall_points<const D: usize>(ws: &WallSet<D>, div: &mut Vec<Point<D>>, 
 
 /// The sources a fluid particle sums over: its own body, then the walls (if any) with
 /// their two views. `f(pair, b, b_viscous, b_is_fluid)`.
-struct Sources<'a, const D: usize> {
+pub(super) struct Sources<'a, const D: usize> {
     h: f64,
     x: &'a [Vector<D>],
     nl: &'a KernelList<D>,
@@ -194,6 +209,16 @@ impl<const D: usize> FluidPasses<D> {
         if let Some(ws) = walls {
             gather_wall_points(ws, &mut self.wall_div, &mut self.wall_visc);
         }
+        self.sources(fluid, nl, walls)
+    }
+
+    /// The sources of a pass as last gathered.
+    pub(super) fn sources<'a>(
+        &'a self,
+        fluid: &'a Fluid<D>,
+        nl: &'a KernelList<D>,
+        walls: Option<&'a WallSet<D>>,
+    ) -> Sources<'a, D> {
         Sources {
             h: fluid.h,
             x: &fluid.x,
@@ -201,6 +226,30 @@ impl<const D: usize> FluidPasses<D> {
             pts: &self.points,
             walls: walls.map(|ws| (ws, &self.wall_div[..], &self.wall_visc[..])),
         }
+    }
+
+    /// Sets the density and pressure of the particles `range` with `set(i, rho_i, p_i)` and
+    /// gathers their views anew, in one parallel loop.
+    pub(super) fn set_and_regather(
+        &mut self,
+        fluid: &mut Fluid<D>,
+        range: std::ops::Range<usize>,
+        set: impl Fn(usize, &mut f64, &mut f64) + Sync,
+    ) {
+        let Fluid { u, u_hat, m, rho, p, .. } = fluid;
+        let u_hat = u_hat.as_deref().unwrap_or(u);
+        let (u, m, first) = (&u[..], &m[..], range.start);
+        self.points.resize(u.len(), Point::new(u[0], u_hat[0], m[0], rho[0], p[0]));
+        self.points[range.clone()]
+            .par_iter_mut()
+            .zip(rho[range.clone()].par_iter_mut().zip(p[range].par_iter_mut()))
+            .enumerate()
+            .with_min_len(MIN_LEN)
+            .for_each(|(k, (pt, (rho, p)))| {
+                let i = first + k;
+                set(i, rho, p);
+                *pt = Point::new(u[i], u_hat[i], m[i], *rho, *p);
+            });
     }
 
     /// Summation density, `rho_a = sum_b m_b W_ab` over the fluid and the walls: the
@@ -243,12 +292,7 @@ impl<const D: usize> FluidPasses<D> {
                     .enumerate()
                     .with_min_len(MIN_LEN)
                     .for_each(|(i, (dp, drho))| (*dp, *drho) = rate(i)),
-                (true, false) => rates
-                    .dp
-                    .par_iter_mut()
-                    .enumerate()
-                    .with_min_len(MIN_LEN)
-                    .for_each(|(i, dp)| *dp = rate(i).0),
+                (true, false) => pressure_rates(&terms, &src, 0, &mut rates.dp),
                 (false, _) => rates
                     .drho
                     .par_iter_mut()
@@ -291,10 +335,30 @@ impl<const D: usize> FluidPasses<D> {
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
-        let src = self.gather(fluid, nl, walls);
+        self.gather(fluid, nl, walls);
+        rates.a_c_dt = shifting_dt(s, dt);
+        let a_c = if writes_homogenisation(s) { &mut rates.a_c[..] } else { &mut [] };
+        self.write_accelerations(fluid, nl, walls, surface, s, dt, 0, &mut rates.du, a_c);
+    }
+
+    /// Pass B over the gathered points, for the particles from `first` on: one per element
+    /// of `du`, with their homogenisation accelerations in `a_c` unless it is empty.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn write_accelerations(
+        &self,
+        fluid: &Fluid<D>,
+        nl: &KernelList<D>,
+        walls: Option<&WallSet<D>>,
+        surface: Option<&SurfaceFields<D>>,
+        s: &FluidScheme,
+        dt: f64,
+        first: usize,
+        du: &mut [Vector<D>],
+        a_c: &mut [Vector<D>],
+    ) {
+        let src = self.sources(fluid, nl, walls);
         let g = s.gravity_vector::<D>();
         let shifting = s.transport.map(|t| t.shifting);
-        let transport = s.transport.is_some();
         let sun_prefactor = match shifting {
             // -(Ma c0) 2h / dt, eq. (36)
             Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
@@ -320,28 +384,46 @@ impl<const D: usize> FluidPasses<D> {
             }
             (acc + g, ac)
         };
-        let ipst = matches!(shifting, Some(Shifting::Ipst { .. }));
-        // Both shifting techniques divide (du/dt)_c by this step (eqs. 36, 41); IPST's pass
-        // below is evaluated with the same one.
-        rates.a_c_dt =
-            matches!(shifting, Some(Shifting::Sun2019 { .. } | Shifting::Ipst { .. })).then_some(dt);
-        if transport && !ipst {
-            rates
-                .du
-                .par_iter_mut()
-                .zip(rates.a_c.par_iter_mut())
+        if a_c.is_empty() {
+            du.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(k, du)| *du = rate(first + k).0);
+        } else {
+            du.par_iter_mut()
+                .zip(a_c.par_iter_mut())
                 .enumerate()
                 .with_min_len(MIN_LEN)
-                .for_each(|(i, (du, ac))| (*du, *ac) = rate(i));
-        } else {
-            // Without transport there is no a_c; IPST fills it in its own pass.
-            rates.du.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, du)| *du = rate(i).0);
+                .for_each(|(k, (du, ac))| (*du, *ac) = rate(first + k));
         }
     }
 }
 
+/// The step a scheme's shifting divides `(du/dt)_c` by, when pass B is evaluated for step
+/// `dt`: both shifting techniques do (eqs. 36, 41; IPST's pass after pass B is evaluated
+/// with the same one), a background pressure does not.
+pub(super) fn shifting_dt(s: &FluidScheme, dt: f64) -> Option<f64> {
+    matches!(s.transport.map(|t| t.shifting), Some(Shifting::Sun2019 { .. } | Shifting::Ipst { .. }))
+        .then_some(dt)
+}
+
+/// Whether pass B writes the homogenisation acceleration: with a transport velocity whose
+/// shifting is not IPST's (without transport there is none; IPST fills it in its own pass).
+pub(super) fn writes_homogenisation(s: &FluidScheme) -> bool {
+    s.transport.is_some_and(|t| !matches!(t.shifting, Shifting::Ipst { .. }))
+}
+
+/// Pass A's EDAC pressure rates (eq. 26) of the particles from `first` on, one per element
+/// of `dp`, without the continuity equation.
+pub(super) fn pressure_rates<const D: usize>(
+    terms: &RateTerms,
+    src: &Sources<'_, D>,
+    first: usize,
+    dp: &mut [f64],
+) {
+    let rate = |i: usize| with_rates_plan!(terms.plan, P => terms.sums::<P, D>(src, i)).0;
+    dp.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(k, dp)| *dp = rate(first + k));
+}
+
 /// The terms of pass A a scheme declares: its plan and the EDAC constants.
-struct RateTerms {
+pub(super) struct RateTerms {
     plan: u32,
     /// EDAC's `c_s^2` and `nu_edac`.
     cs2: f64,
@@ -349,7 +431,7 @@ struct RateTerms {
 }
 
 impl RateTerms {
-    fn new(s: &FluidScheme) -> Self {
+    pub(super) fn new(s: &FluidScheme) -> Self {
         let corr = s.transport.map(|t| t.corrections);
         let continuity = s.density == DensityModel::Continuity;
         let (edac, cs2, nu) = match s.pressure {
