@@ -106,7 +106,9 @@ struct BenchArgs {
     /// Thread counts.
     #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2], value_parser = at_least_one::<usize>)]
     bench_threads: Vec<usize>,
-    /// Variants (edac, ctvf+sun, ctvf+ipst).
+    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps` (e.g. `edac/sweeps`):
+    /// the same case with the step's gather passes one after the other rather than as a
+    /// wavefront over tiles (the same results), to time the two side by side.
     #[arg(long, value_delimiter = ',')]
     variants: Option<Vec<String>>,
     /// Timed steps per case (default: about 4 million particle-steps).
@@ -226,10 +228,6 @@ enum Command {
         steps: u64,
         #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
-        /// The step's gather passes one after the other, not as a wavefront over tiles
-        /// (the same results; for timing the two).
-        #[arg(long)]
-        sweeps: bool,
     },
     /// The cases of one resolution timed side by side in this process (used by
     /// `bench --interleave`).
@@ -347,8 +345,8 @@ fn run(cli: Cli) -> ExitCode {
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
         Command::Bench(args) => run_bench(args),
-        Command::BenchCase { variant, nx, steps, kernel, sweeps } => {
-            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel, !sweeps))
+        Command::BenchCase { variant, nx, steps, kernel } => {
+            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel))
         }
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => print_json(
             bench::run_interleaved(&variants, nx, &bench_threads, steps, rounds, BENCH_WARMUP, &kernel),
@@ -580,9 +578,13 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
     // Every argument is checked before the first case runs, so that a typo costs no sitting.
-    if let Some(v) = variants.iter().find(|v| !bench::VARIANTS.iter().any(|k| k.0 == v.as_str())) {
+    if let Some(v) = variants.iter().find(|v| !bench::known_variant(v)) {
         let known: Vec<&str> = bench::VARIANTS.iter().map(|k| k.0).collect();
-        eprintln!("error: bench: --variants {v}: expected one of {}", known.join(", "));
+        eprintln!(
+            "error: bench: --variants {v}: expected one of {}, each optionally with `{}`",
+            known.join(", "),
+            bench::SWEEPS
+        );
         return ExitCode::from(2);
     }
     if let Some(script) = peer.as_ref().filter(|p| !p.is_file()) {

@@ -215,6 +215,16 @@ pub const DEFAULT_KERNEL: &str = "quintic_spline";
 pub const VARIANTS: &[(&str, &str, &str)] =
     &[("edac", "edac", "none"), ("ctvf+sun", "ctvf", "sun"), ("ctvf+ipst", "ctvf", "ipst")];
 
+/// The suffix of a variant (`edac/sweeps`) timed with the step's gather passes one after
+/// the other rather than as a wavefront over tiles (the same results).
+pub const SWEEPS: &str = "/sweeps";
+
+/// Whether `variant` is one of [`VARIANTS`], optionally with the suffix [`SWEEPS`].
+pub fn known_variant(variant: &str) -> bool {
+    let base = variant.strip_suffix(SWEEPS).unwrap_or(variant);
+    VARIANTS.iter().any(|v| v.0 == base)
+}
+
 fn status_kb(field: &str) -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
@@ -233,18 +243,13 @@ fn status_kb(field: &str) -> u64 {
 /// Taylor-Green flow sits there (measured at nx = 50 and 100: from t = 0.09 on, every step
 /// makes the 10 moves), while the first steps of a run barely iterate, so timing those would
 /// understate its cost.
-/// It is returned after `warmup` untimed steps; `wavefront` as [`Simulation::set_wavefront`].
-fn case_simulation(
-    variant: &str,
-    nx: usize,
-    kernel: &str,
-    warmup: u64,
-    wavefront: bool,
-) -> Result<Simulation<2>, String> {
-    let (_, scheme, pst) = VARIANTS
-        .iter()
-        .find(|v| v.0 == variant)
-        .ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
+/// A variant may end in [`SWEEPS`]: the same case with the step's gather passes one after
+/// the other instead of as a wavefront ([`Simulation::set_wavefront`]), for timing the two
+/// side by side. It is returned after `warmup` untimed steps.
+fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Result<Simulation<2>, String> {
+    let (base, sweeps) = variant.strip_suffix(SWEEPS).map_or((variant, false), |b| (b, true));
+    let (_, scheme, pst) =
+        VARIANTS.iter().find(|v| v.0 == base).ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
     let (nx, scheme, kernel) = (format!("nx={nx}"), format!("scheme={scheme}"), format!("kernel={kernel}"));
     let pst_set = format!("pst={pst}");
     let mut sets =
@@ -254,7 +259,7 @@ fn case_simulation(
     }
     let p = taylor_green::params_from(&sets)?;
     let mut sim = taylor_green::simulation::<2>(&p)?;
-    sim.set_wavefront(wavefront);
+    sim.set_wavefront(!sweeps);
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
@@ -365,10 +370,9 @@ pub fn run_case(
     steps: u64,
     warmup: u64,
     kernel: &str,
-    wavefront: bool,
 ) -> Result<BenchResult, String> {
     let rss0 = status_kb("VmRSS:") * 1024;
-    let mut sim = case_simulation(variant, nx, kernel, warmup, wavefront)?;
+    let mut sim = case_simulation(variant, nx, kernel, warmup)?;
     let mut timed = Timed::default();
     timed.steps(&mut sim, steps)?;
     let n = sim.fluid().len();
@@ -420,10 +424,10 @@ pub fn run_interleaved(
     let mut sims = Vec::new();
     for v in variants {
         let rss0 = status_kb("VmRSS:") * 1024;
-        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup, true))?;
+        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
         let grown = (status_kb("VmRSS:") * 1024).saturating_sub(rss0);
         let copies = (1..most_copies)
-            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup, true)))
+            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup)))
             .collect::<Result<Vec<_>, _>>()?;
         sims.push((sim, copies, grown));
     }
@@ -846,6 +850,18 @@ mod peer_tests {
         let two = run_interleaved(&variants[..1], 12, &[2], 2, 2, 0, DEFAULT_KERNEL).unwrap();
         assert_eq!(two.iter().map(|r| r.copies).collect::<Vec<_>>(), [1]);
         assert!(run_interleaved(&["sph".to_string()], 12, &[1], 2, 2, 0, DEFAULT_KERNEL).is_err());
+    }
+
+    /// A variant with `/sweeps` is the same case with its passes one after the other: known,
+    /// timed, and named as given; any other suffix is refused.
+    #[test]
+    fn sweeps_variants_are_the_same_cases() {
+        assert!(known_variant("edac") && known_variant("edac/sweeps") && known_variant("ctvf+ipst/sweeps"));
+        assert!(!known_variant("edac/sweep") && !known_variant("sph/sweeps") && !known_variant("/sweeps"));
+        let variants = ["edac".to_string(), "edac/sweeps".to_string()];
+        let r = run_interleaved(&variants, 12, &[1], 3, 2, 1, DEFAULT_KERNEL).unwrap();
+        assert_eq!(r.iter().map(|r| r.variant.as_str()).collect::<Vec<_>>(), ["edac", "edac/sweeps"]);
+        assert!(run_interleaved(&["edac/tiles".to_string()], 12, &[1], 2, 2, 0, DEFAULT_KERNEL).is_err());
     }
 
     /// A result written before copies were timed reads back as one copy.

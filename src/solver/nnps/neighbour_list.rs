@@ -249,9 +249,10 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     /// Hands the storage of chunk `dead`, whose points will not be queried again before the
     /// next build, to chunk `next`, about to be built (and `next`'s to `dead`): a build of
     /// many chunks then writes into memory just read, still in cache, rather than into
-    /// memory last touched a build ago.
+    /// memory last touched a build ago. A query of a point of `dead` then panics.
     pub fn recycle(&mut self, dead: usize, next: usize) {
         self.chunks.swap(dead, next);
+        self.chunks[dead].start.clear();
     }
 
     /// Lists the points of `chunks` (after [`begin`](Self::begin)), as

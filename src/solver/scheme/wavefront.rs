@@ -141,7 +141,7 @@ impl Wavefront {
         }
         self.bounds.clear();
         self.bounds.extend((0..tiles).map(|k| k * width));
-        // The last tile takes the remainder, so that it is as wide as the others.
+        // The last tile takes the remainder, so that it is at least as wide as the others.
         self.bounds.push(n);
         self.reach_holds()
     }
