@@ -106,9 +106,10 @@ struct BenchArgs {
     /// Thread counts.
     #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2], value_parser = at_least_one::<usize>)]
     bench_threads: Vec<usize>,
-    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps` (e.g. `edac/sweeps`):
-    /// the same case with the step's gather passes one after the other rather than as a
-    /// wavefront over tiles (the same results), to time the two side by side.
+    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps` or `/wavefront` (e.g.
+    /// `edac/sweeps`): the same case with the step's passes one after the other, or tile by
+    /// tile (the same results), to time the two side by side; without, the step takes the
+    /// faster of the two on this host.
     #[arg(long, value_delimiter = ',')]
     variants: Option<Vec<String>>,
     /// Timed steps per case (default: about 4 million particle-steps).
@@ -452,8 +453,9 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &s
         .ok_or_else(|| "summary.json: no `l1_velocity_final`".to_string())
 }
 
-/// Untimed steps before a bench case is timed.
-const BENCH_WARMUP: u64 = 5;
+/// Untimed steps before a bench case is timed: enough for a tuned step schedule to have
+/// timed both of its choices (five steps each) and kept one.
+const BENCH_WARMUP: u64 = 12;
 
 /// A bench child's result as one JSON line on stdout, or its error on stderr (exit 1).
 fn print_json(r: Result<impl serde::Serialize, String>) -> ExitCode {
@@ -580,10 +582,11 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     // Every argument is checked before the first case runs, so that a typo costs no sitting.
     if let Some(v) = variants.iter().find(|v| !bench::known_variant(v)) {
         let known: Vec<&str> = bench::VARIANTS.iter().map(|k| k.0).collect();
+        let suffixes: Vec<&str> = bench::SCHEDULES.iter().map(|s| s.0).collect();
         eprintln!(
-            "error: bench: --variants {v}: expected one of {}, each optionally with `{}`",
+            "error: bench: --variants {v}: expected one of {}, each optionally ending in {}",
             known.join(", "),
-            bench::SWEEPS
+            suffixes.join(" or ")
         );
         return ExitCode::from(2);
     }

@@ -8,7 +8,7 @@
 pub mod targets;
 
 use crate::scenes::taylor_green;
-use crate::solver::simulation::{PhaseTimes, Simulation};
+use crate::solver::simulation::{PhaseTimes, Schedule, Simulation};
 use crate::solver::warm;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -215,13 +215,23 @@ pub const DEFAULT_KERNEL: &str = "quintic_spline";
 pub const VARIANTS: &[(&str, &str, &str)] =
     &[("edac", "edac", "none"), ("ctvf+sun", "ctvf", "sun"), ("ctvf+ipst", "ctvf", "ipst")];
 
-/// The suffix of a variant (`edac/sweeps`) timed with the step's gather passes one after
-/// the other rather than as a wavefront over tiles (the same results).
-pub const SWEEPS: &str = "/sweeps";
+/// The suffixes of a variant that fix the order of its step's passes (`edac/sweeps`,
+/// `edac/wavefront`: the same results, for timing the two side by side); without one, the
+/// step takes the faster on this host ([`Schedule::Tuned`]).
+pub const SCHEDULES: &[(&str, Schedule)] =
+    &[("/sweeps", Schedule::Sweeps), ("/wavefront", Schedule::Wavefront)];
 
-/// Whether `variant` is one of [`VARIANTS`], optionally with the suffix [`SWEEPS`].
+/// A variant's case and schedule.
+fn split_variant(variant: &str) -> (&str, Schedule) {
+    SCHEDULES
+        .iter()
+        .find_map(|&(suffix, s)| variant.strip_suffix(suffix).map(|base| (base, s)))
+        .unwrap_or((variant, Schedule::Tuned))
+}
+
+/// Whether `variant` is one of [`VARIANTS`], optionally with a suffix of [`SCHEDULES`].
 pub fn known_variant(variant: &str) -> bool {
-    let base = variant.strip_suffix(SWEEPS).unwrap_or(variant);
+    let base = split_variant(variant).0;
     VARIANTS.iter().any(|v| v.0 == base)
 }
 
@@ -243,11 +253,10 @@ fn status_kb(field: &str) -> u64 {
 /// Taylor-Green flow sits there (measured at nx = 50 and 100: from t = 0.09 on, every step
 /// makes the 10 moves), while the first steps of a run barely iterate, so timing those would
 /// understate its cost.
-/// A variant may end in [`SWEEPS`]: the same case with the step's gather passes one after
-/// the other instead of as a wavefront ([`Simulation::set_wavefront`]), for timing the two
-/// side by side. It is returned after `warmup` untimed steps.
+/// A variant may end in a suffix of [`SCHEDULES`]. It is returned after `warmup` untimed
+/// steps, in which a tuned schedule has made its choice.
 fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Result<Simulation<2>, String> {
-    let (base, sweeps) = variant.strip_suffix(SWEEPS).map_or((variant, false), |b| (b, true));
+    let (base, schedule) = split_variant(variant);
     let (_, scheme, pst) =
         VARIANTS.iter().find(|v| v.0 == base).ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
     let (nx, scheme, kernel) = (format!("nx={nx}"), format!("scheme={scheme}"), format!("kernel={kernel}"));
@@ -259,7 +268,7 @@ fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Resul
     }
     let p = taylor_green::params_from(&sets)?;
     let mut sim = taylor_green::simulation::<2>(&p)?;
-    sim.set_wavefront(!sweeps);
+    sim.set_schedule(schedule);
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
@@ -856,11 +865,14 @@ mod peer_tests {
     /// timed, and named as given; any other suffix is refused.
     #[test]
     fn sweeps_variants_are_the_same_cases() {
-        assert!(known_variant("edac") && known_variant("edac/sweeps") && known_variant("ctvf+ipst/sweeps"));
+        assert!(
+            known_variant("edac") && known_variant("edac/sweeps") && known_variant("ctvf+ipst/wavefront")
+        );
         assert!(!known_variant("edac/sweep") && !known_variant("sph/sweeps") && !known_variant("/sweeps"));
-        let variants = ["edac".to_string(), "edac/sweeps".to_string()];
+        let variants = ["edac".to_string(), "edac/sweeps".to_string(), "edac/wavefront".to_string()];
         let r = run_interleaved(&variants, 12, &[1], 3, 2, 1, DEFAULT_KERNEL).unwrap();
-        assert_eq!(r.iter().map(|r| r.variant.as_str()).collect::<Vec<_>>(), ["edac", "edac/sweeps"]);
+        let names: Vec<_> = r.iter().map(|r| r.variant.as_str()).collect();
+        assert_eq!(names, ["edac", "edac/sweeps", "edac/wavefront"]);
         assert!(run_interleaved(&["edac/tiles".to_string()], 12, &[1], 2, 2, 0, DEFAULT_KERNEL).is_err());
     }
 

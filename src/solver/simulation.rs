@@ -5,10 +5,11 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
+pub use crate::solver::scheme::Schedule;
 use crate::solver::scheme::{
     build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, wavefront_applies,
     DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, Shifting, StepBodies, SurfaceFields,
-    SurfacePressure, WallSet, Wavefront,
+    SurfacePressure, Tuner, WallSet, Wavefront,
 };
 use crate::solver::{warm, LIGHT_LOOP_LEN};
 use rayon::prelude::*;
@@ -148,9 +149,11 @@ pub struct Simulation<const D: usize> {
     /// The fluid's share of the summation density, summed as the list is built.
     fluid_density: Vec<f64>,
     passes: FluidPasses<D>,
-    /// The tiles of the wavefront step, whether it may run, and the steps it ran.
+    /// The tiles of the wavefront step, the schedule asked for and its tuner, and the steps
+    /// that ran as a wavefront.
     wave: Wavefront,
-    wavefront: bool,
+    schedule: Schedule,
+    tuner: Tuner,
     wavefront_steps: u64,
     /// Time per phase of the step, summed over the run.
     pub times: PhaseTimes,
@@ -190,7 +193,8 @@ impl<const D: usize> Simulation<D> {
             fluid_density: Vec::new(),
             passes: FluidPasses::new(),
             wave: Wavefront::new(),
-            wavefront: true,
+            schedule: Schedule::default(),
+            tuner: Tuner::default(),
             wavefront_steps: 0,
             times: PhaseTimes::default(),
         };
@@ -270,25 +274,27 @@ impl<const D: usize> Simulation<D> {
         self.cells.mark_reordered();
     }
 
-    /// Whether the step's gather passes may run as a wavefront over tiles
-    /// ([`Wavefront`]); on by default. Off, they run one after the other, with the same
-    /// results bit for bit (for timing the two).
-    pub fn set_wavefront(&mut self, on: bool) {
-        self.wavefront = on;
+    /// How the step's gather passes are ordered ([`Schedule`]; by default the faster of the
+    /// sweeps and the wavefront on this host). Every schedule gives the same results, bit
+    /// for bit.
+    pub fn set_schedule(&mut self, schedule: Schedule) {
+        self.schedule = schedule;
+    }
+
+    /// Whether this step's listing and passes can run as a wavefront ([`Wavefront`]): the
+    /// scheme allows it and the body, as binned now, makes enough tiles.
+    fn tiles_planned(&mut self) -> bool {
+        let st = &self.state;
+        self.schedule != Schedule::Sweeps
+            && self.time_settings.rate_positions == RatePositions::End
+            && wavefront_applies(&st.scheme, self.walls.is_some(), self.surface.is_some())
+            && self.wave.plan(&self.cells, st.fluid.len())
     }
 
     /// The listing, summation density, pass A over `dt` and pass B of a step as a
-    /// wavefront, if the scheme and the body allow one ([`Wavefront`]); returns whether it
-    /// ran.
-    fn wavefront_step(&mut self, dt: f64, dt_nominal: f64) -> bool {
+    /// wavefront over the tiles just planned.
+    fn wavefront_passes(&mut self, dt: f64, dt_nominal: f64) {
         let st = &mut self.state;
-        if !(self.wavefront
-            && self.time_settings.rate_positions == RatePositions::End
-            && wavefront_applies(&st.scheme, self.walls.is_some(), self.surface.is_some())
-            && self.wave.plan(&self.cells, st.fluid.len()))
-        {
-            return false;
-        }
         let bodies = StepBodies {
             fluid: &mut st.fluid,
             cells: &self.cells,
@@ -303,7 +309,26 @@ impl<const D: usize> Simulation<D> {
         self.times.pressure += t.pressure;
         self.times.accelerations += t.accelerations;
         self.wavefront_steps += 1;
-        true
+    }
+
+    /// The listing, summation density, pass A over `dt` (if the rates are taken after the
+    /// drift) and pass B of a step, each over the whole body.
+    fn swept_passes(&mut self, dt: f64, dt_nominal: f64) {
+        let clock = std::time::Instant::now();
+        self.relist();
+        let mut clock = lap(clock, &mut self.times.neighbours);
+        if self.state.scheme.density == DensityModel::Summation {
+            let walls = self.walls.as_ref();
+            FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
+            clock = lap(clock, &mut self.times.density);
+        }
+        if self.time_settings.rate_positions == RatePositions::End {
+            self.update_density_and_pressure(dt);
+        }
+        // The walls follow the fluid's new pressure before the accelerations use it.
+        self.extrapolate_walls();
+        lap(clock, &mut self.times.pressure);
+        self.accelerations(dt_nominal);
     }
 
     /// The neighbour lists from the current binning, and the wall extrapolation.
@@ -356,6 +381,12 @@ impl<const D: usize> Simulation<D> {
 
     /// The accelerations of the state, for step `next_step` (0 the first).
     fn evaluate_accelerations(&mut self, dt_nominal: f64, next_step: u64) {
+        self.accelerations(dt_nominal);
+        self.homogenise(dt_nominal, next_step);
+    }
+
+    /// The free surface, if declared, and pass B.
+    fn accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
         if let (Some(fs), Some(free)) = (self.surface.as_mut(), self.state.scheme.free_surface) {
             let st = &mut self.state;
@@ -379,7 +410,6 @@ impl<const D: usize> Simulation<D> {
             dt_nominal,
         );
         lap(clock, &mut self.times.accelerations);
-        self.homogenise(dt_nominal, next_step);
     }
 
     /// IPST's pass (eqs. 37-41), if the scheme shifts with it, after pass B.
@@ -444,26 +474,20 @@ impl<const D: usize> Simulation<D> {
         let clock = lap(clock, &mut self.times.integrate);
         self.rebin();
         lap(clock, &mut self.times.neighbours);
-        // For the next step (its kick applies the homogenisation acceleration).
-        if self.wavefront_step(dt, dt_nominal) {
-            self.homogenise(dt_nominal, self.state.steps + 1);
+        // The listing and the passes, for the next step (its kick applies the
+        // homogenisation acceleration): tile by tile or pass by pass, as the schedule says.
+        let tiled = self.tiles_planned();
+        let wavefront = tiled && (self.schedule == Schedule::Wavefront || self.tuner.wavefront());
+        let clock = std::time::Instant::now();
+        if wavefront {
+            self.wavefront_passes(dt, dt_nominal);
         } else {
-            let clock = std::time::Instant::now();
-            self.relist();
-            let mut clock = lap(clock, &mut self.times.neighbours);
-            if self.state.scheme.density == DensityModel::Summation {
-                let walls = self.walls.as_ref();
-                FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
-                clock = lap(clock, &mut self.times.density);
-            }
-            if rates_at == RatePositions::End {
-                self.update_density_and_pressure(dt);
-            }
-            // The walls follow the fluid's new pressure before the accelerations use it.
-            self.extrapolate_walls();
-            lap(clock, &mut self.times.pressure);
-            self.evaluate_accelerations(dt_nominal, self.state.steps + 1);
+            self.swept_passes(dt, dt_nominal);
         }
+        if tiled && self.schedule == Schedule::Tuned {
+            self.tuner.record(wavefront, clock.elapsed().as_secs_f64());
+        }
+        self.homogenise(dt_nominal, self.state.steps + 1);
         let clock = std::time::Instant::now();
         let st = &mut self.state;
         integrator::kick(&mut st.fluid.u, &st.rates.du, dt);
@@ -689,12 +713,13 @@ mod tests {
         let cases =
             [(SchemeName::Edac, Pst::None), (SchemeName::Ctvf, Pst::Sun), (SchemeName::Ctvf, Pst::Ipst)];
         for (scheme, pst) in cases {
-            let run = |wavefront: bool, threads: usize| {
+            let run = |schedule: Schedule, threads: usize| {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
                 pool.install(|| {
                     let mut sim = vortex_sized(128, scheme, pst, RatePositions::End);
                     sim.wave = Wavefront::with_limits(1, 4);
-                    sim.set_wavefront(wavefront);
+                    sim.set_schedule(schedule);
+                    let wavefront = schedule == Schedule::Wavefront;
                     for _ in 0..4 {
                         sim.step(f64::INFINITY).unwrap();
                     }
@@ -713,9 +738,9 @@ mod tests {
                     bits
                 })
             };
-            let sweeps = run(false, 1);
-            assert_eq!(run(true, 1), sweeps, "{scheme:?} {pst:?}, one thread");
-            assert_eq!(run(true, 2), sweeps, "{scheme:?} {pst:?}, two threads");
+            let sweeps = run(Schedule::Sweeps, 1);
+            assert_eq!(run(Schedule::Wavefront, 1), sweeps, "{scheme:?} {pst:?}, one thread");
+            assert_eq!(run(Schedule::Wavefront, 2), sweeps, "{scheme:?} {pst:?}, two threads");
         }
     }
 }
