@@ -147,6 +147,19 @@ fn a_finished_run_is_not_overwritten_without_force() {
     assert_eq!(s["params"]["tf"], 0.04);
 }
 
+/// A body of 65 536 particles makes tiles: the run times both orders of its passes on its
+/// first steps (five each), and the summary counts the steps that ran as a wavefront.
+#[test]
+fn a_large_periodic_run_counts_its_wavefront_steps() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, err) = simulate(dir.path(), "taylor_green", &["nx=256", "tf=0.0015", "scheme=edac"]);
+    assert_eq!(code, 0, "{err}");
+    let s = summary(dir.path());
+    let (steps, wave) = (s["steps"].as_u64().unwrap(), s["wavefront_steps"].as_u64().unwrap());
+    assert!(steps >= 10, "{steps} steps: the test needs the tuning done");
+    assert!((5..=steps).contains(&wave), "{wave} of {steps} steps as a wavefront");
+}
+
 #[test]
 fn a_completed_run_writes_the_contracted_outputs() {
     let dir = tempfile::tempdir().unwrap();
@@ -169,6 +182,8 @@ fn a_completed_run_writes_the_contracted_outputs() {
     }
     assert_eq!(s["status"], "completed");
     assert_eq!(s["particles"], 256);
+    // Too small a body for tiles: every step swept.
+    assert_eq!(s["wavefront_steps"], 0);
     assert!((s["final_time"].as_f64().unwrap() - 0.05).abs() < 1e-12);
     for m in [
         "l1_velocity_final",

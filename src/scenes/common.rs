@@ -423,6 +423,9 @@ macro_rules! forward_to_sim {
         fn steps(&self) -> u64 {
             self.sim.steps()
         }
+        fn wavefront_steps(&self) -> u64 {
+            self.sim.wavefront_steps()
+        }
         fn advance(
             &mut self,
             t_stop: f64,

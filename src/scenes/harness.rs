@@ -326,6 +326,7 @@ fn summary(
             0.0
         },
         threads: rayon::current_num_threads(),
+        wavefront_steps: scene.wavefront_steps(),
         status,
         reason,
         step: None,

@@ -28,6 +28,9 @@ pub trait SceneRun {
     fn time(&self) -> f64;
     /// Steps taken.
     fn steps(&self) -> u64;
+    /// Steps of this process whose listing and passes ran as a wavefront over tiles (the
+    /// others as sweeps; the results are the same).
+    fn wavefront_steps(&self) -> u64;
     /// The plan (bodies, scheme and terms), written at the top of the run log.
     fn plan(&self) -> String;
     /// Steps until the time reaches `t_stop` (steps are not shortened for it) without

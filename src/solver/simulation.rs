@@ -274,6 +274,12 @@ impl<const D: usize> Simulation<D> {
         self.cells.mark_reordered();
     }
 
+    /// Steps of this simulation (since it was built) whose listing and passes ran as a
+    /// wavefront over tiles.
+    pub fn wavefront_steps(&self) -> u64 {
+        self.wavefront_steps
+    }
+
     /// How the step's gather passes are ordered ([`Schedule`]; by default the faster of the
     /// sweeps and the wavefront on this host). Every schedule gives the same results, bit
     /// for bit.

@@ -113,6 +113,11 @@ pub struct Summary {
     pub particle_steps_per_second: f64,
     /// Rayon threads.
     pub threads: usize,
+    /// Steps of this run's last process whose listing and passes ran as a wavefront over
+    /// tiles rather than as sweeps (the same results; the faster on the host, see
+    /// `solver::scheme::Schedule`).
+    #[serde(default)]
+    pub wavefront_steps: u64,
     /// How it ended.
     pub status: Status,
     /// Why it diverged or failed.
