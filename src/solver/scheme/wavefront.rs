@@ -21,7 +21,8 @@
 //! Every particle's sums are the same sums, over the same neighbours in the same order, as
 //! in the sweeps one after the other; only the order in which particles are visited
 //! changes. The results are bit for bit those of the sweeps, on any number of threads
-//! (tested).
+//! (tested). Which of the two is faster depends on the host's cache, so by default a run
+//! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
 
 use super::passes::{
     build_kernel_chunks_summing_density, pressure_rates, shifting_dt, writes_homogenisation, RateTerms,
