@@ -117,9 +117,9 @@ impl Wavefront {
     }
 
     /// Cuts the `n` particles binned by `cells` (in cell order) into tiles of whole list
-    /// chunks, each at least two cell layers and a chunk wide (and [`MIN_TILE_CHUNKS`]),
+    /// chunks, each at least two cell layers and a chunk wide (and `MIN_TILE_CHUNKS`),
     /// and checks that every particle's neighbours lie in its tile or the next ones
-    /// (cyclically). Returns whether the body makes at least [`MIN_TILES`] such tiles.
+    /// (cyclically). Returns whether the body makes at least `MIN_TILES` (16) such tiles.
     pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize) -> bool {
         let (min_tile_chunks, min_tiles) = self.limits;
         self.layers.clear();
@@ -231,7 +231,7 @@ const TRIALS: usize = 5;
 /// property of the host: on the host of session 35 the wavefront was 1.45x faster at
 /// nx = 400 but 10 % slower on two threads at nx = 256, where the list still fitted its
 /// cache; on hosts whose memory kept up with the sweeps, only its cost would show. The
-/// first steps alternate between the two, [`TRIALS`] each, then the one with the shorter
+/// first steps alternate between the two, five each, then the one with the shorter
 /// median step is kept. Either gives the same results, so the choice changes only the
 /// speed.
 #[derive(Clone, Debug, Default)]
