@@ -110,6 +110,8 @@ struct Chunk<const D: usize, P> {
     start: Vec<u32>,
     entries: Vec<u32>,
     payload: Vec<P>,
+    /// Whether the payload was handed to another chunk since this one was built.
+    payload_stale: bool,
     /// Scratch: |x_ij|^2 of the pairs whose payload is computed next.
     r2: Vec<f64>,
     /// Scratch: the candidates around the current cell, packed,
@@ -122,6 +124,7 @@ struct Chunk<const D: usize, P> {
 
 impl<const D: usize, P: Copy + Default> Chunk<D, P> {
     fn clear(&mut self) {
+        self.payload_stale = false;
         self.start.clear();
         self.entries.clear();
         self.payload.clear();
@@ -246,13 +249,15 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         0..self.chunks.len()
     }
 
-    /// Hands the storage of chunk `dead`, whose points will not be queried again before the
-    /// next build, to chunk `next`, about to be built (and `next`'s to `dead`): a build of
-    /// many chunks then writes into memory just read, still in cache, rather than into
-    /// memory last touched a build ago. A query of a point of `dead` then panics.
+    /// Hands the payload storage of chunk `dead`, whose payloads will not be read again
+    /// before the next build, to chunk `next`, about to be built (and `next`'s to `dead`):
+    /// the payloads, most of a list's bytes, are then written into memory just read, still
+    /// in cache, rather than into memory last touched a build ago. `dead` keeps its pairs
+    /// ([`half_pairs`](Self::half_pairs) still reads them); a query of its payloads panics.
     pub fn recycle(&mut self, dead: usize, next: usize) {
-        self.chunks.swap(dead, next);
-        self.chunks[dead].start.clear();
+        let payload = std::mem::take(&mut self.chunks[dead].payload);
+        self.chunks[dead].payload = std::mem::replace(&mut self.chunks[next].payload, payload);
+        self.chunks[dead].payload_stale = true;
     }
 
     /// Lists the points of `chunks` (after [`begin`](Self::begin)), as
@@ -280,6 +285,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                 // The entries and payload keep their length (the room of the last build):
                 // they only grow, so that no point's room is zeroed before it is written.
                 chunk.start.clear();
+                chunk.payload_stale = false;
                 let mut len = 0;
                 // Points are visited in cell order, so the candidates of a cell serve every
                 // point in it.
@@ -412,6 +418,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
             "a record and a position for each point the list was built from"
         );
         let (chunk, range) = self.range(i);
+        assert!(!chunk.payload_stale, "point {i}: its payloads were handed on (`recycle`)");
         let shifts = self.shift_table();
         for (&e, p) in chunk.entries[range.clone()].iter().zip(&chunk.payload[range]) {
             let j = (e & J_MASK) as usize;

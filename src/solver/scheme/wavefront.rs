@@ -12,11 +12,12 @@
 //! of a tile then needs only the previous stage done on the tile and its two neighbours,
 //! and the stages run one tile behind each other: listing tile t, pass A on tile t - 1,
 //! the pressure update on tile t - 2, pass B on tile t - 3. Only about four tiles of the
-//! list are alive at a time. Once a tile's pass B has run its list is dead (unless IPST
-//! sweeps the whole list after the step), and its storage goes to the next tile listed, so
+//! list are alive at a time. Once a tile's pass B has run its payloads (the kernel values,
+//! 24 of a pair's 28 bytes) are dead, and their storage goes to the next tile listed, so
 //! that the listing writes into memory still in cache rather than into memory last
 //! touched a step ago: without that hand-over the wavefront took 12 % off a step at
-//! nx = 400, with it 32 % (one thread; the same as at nx = 200).
+//! nx = 400, with it 32 % (one thread; the same as at nx = 200). The pairs themselves stay,
+//! for IPST's sweeps after the step.
 //!
 //! Every particle's sums are the same sums, over the same neighbours in the same order, as
 //! in the sweeps one after the other; only the order in which particles are visited
@@ -27,7 +28,7 @@
 use super::passes::{
     build_kernel_chunks_summing_density, pressure_rates, shifting_dt, writes_homogenisation, RateTerms,
 };
-use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference, Shifting};
+use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference};
 use crate::solver::kernel::Kernel;
 use crate::solver::nnps::{CellList, CHUNK};
 use crate::solver::particles::{Fluid, FluidRates};
@@ -318,9 +319,8 @@ impl<const D: usize> FluidPasses<D> {
         rates.a_c_dt = shifting_dt(scheme, dt_accel);
         let terms = RateTerms::new(scheme);
         let writes_ac = writes_homogenisation(scheme);
-        // IPST's sweeps read the whole list after the step's passes; otherwise a tile's list
-        // is dead once its pass B ran, and its storage goes to the next tile listed.
-        let recycle = !matches!(scheme.transport.map(|t| t.shifting), Some(Shifting::Ipst { .. }));
+        // A tile's payloads are dead once its pass B ran; their storage goes to the next tile
+        // listed. (IPST, after the step, reads only the pairs.)
         let mut times = StageTimes::default();
         wave.order_stages();
         wave.dead.clear();
@@ -330,12 +330,10 @@ impl<const D: usize> FluidPasses<D> {
             match stage {
                 Stage::List => {
                     let chunks = r.start / CHUNK..r.end.div_ceil(CHUNK);
-                    if recycle {
-                        if let Some(dead) = wave.dead.pop_front() {
-                            let from = wave.range(dead).start / CHUNK..wave.range(dead).end.div_ceil(CHUNK);
-                            for (d, c) in from.zip(chunks.clone()) {
-                                list.recycle(d, c);
-                            }
+                    if let Some(dead) = wave.dead.pop_front() {
+                        let from = wave.range(dead).start / CHUNK..wave.range(dead).end.div_ceil(CHUNK);
+                        for (d, c) in from.zip(chunks.clone()) {
+                            list.recycle(d, c);
                         }
                     }
                     let rho = &mut fluid_density[r.clone()];
