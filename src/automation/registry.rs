@@ -820,7 +820,7 @@ impl Expand<'_> {
         cases: &[Case],
         ids: &mut BTreeMap<String, usize>,
     ) -> Result<Figure, String> {
-        let Expand { loc, scene, specs, preset, .. } = *self;
+        let Expand { loc, scene, preset, .. } = *self;
         let span = f.span();
         let f = f.get_ref();
         let key = format!("figures.{}", f.id);
@@ -828,9 +828,7 @@ impl Expand<'_> {
         let select = self.select(&f.cases, &f.where_)?;
         nonempty(loc, span.clone(), &key, &select, cases, preset)?;
         for l in &f.label {
-            if !specs.iter().any(|s| s.name == l) {
-                return Err(loc.err(span, &key, format!("`label` names no parameter `{l}`")));
-            }
+            self.parameter(span.clone(), &key, "label", l)?;
         }
         if let Some(m) = &f.metric {
             check_metric(loc, span.clone(), &key, scene, m)?;
@@ -1014,10 +1012,17 @@ impl Expand<'_> {
 
     /// The swept parameter `x` of a `trade` or `stability` figure: one the scene has.
     fn swept(&self, span: Span, key: &str, x: String) -> Result<String, String> {
-        if !self.specs.iter().any(|s| s.name == x) {
-            return Err(self.loc.err(span, key, format!("`x` names no parameter `{x}`")));
-        }
+        self.parameter(span, key, "x", &x)?;
         Ok(x)
+    }
+
+    /// Checks that `name`, given as `what` under `key`, is a parameter of the scene (a
+    /// figure's labels and swept `x`, a table's columns).
+    fn parameter(&self, span: Span, key: &str, what: &str, name: &str) -> Result<(), String> {
+        if !self.specs.iter().any(|s| s.name == name) {
+            return Err(self.loc.err(span, key, format!("`{what}` names no parameter `{name}`")));
+        }
+        Ok(())
     }
 
     /// One table, checked against the scene and the cases (`ids` holds the ids taken).
@@ -1027,7 +1032,7 @@ impl Expand<'_> {
         cases: &[Case],
         ids: &mut BTreeMap<String, usize>,
     ) -> Result<Table, String> {
-        let Expand { loc, scene, specs, preset, .. } = *self;
+        let Expand { loc, scene, preset, .. } = *self;
         let span = t.span();
         let t = t.get_ref();
         let key = format!("tables.{}", t.id);
@@ -1038,9 +1043,7 @@ impl Expand<'_> {
             check_metric(loc, span.clone(), &key, scene, m)?;
         }
         for c in &t.columns {
-            if !specs.iter().any(|s| s.name == c) {
-                return Err(loc.err(span, &key, format!("`columns` names no parameter `{c}`")));
-            }
+            self.parameter(span.clone(), &key, "columns", c)?;
         }
         Ok(Table {
             id: t.id.clone(),
