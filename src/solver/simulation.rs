@@ -293,7 +293,7 @@ impl<const D: usize> Simulation<D> {
         let st = &self.state;
         self.schedule != Schedule::Sweeps
             && self.time_settings.rate_positions == RatePositions::End
-            && wavefront_applies(&st.scheme, self.walls.is_some(), self.surface.is_some())
+            && wavefront_applies(&st.scheme, self.walls.is_some())
             && self.wave.plan(&self.cells, st.fluid.len())
     }
 

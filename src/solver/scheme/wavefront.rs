@@ -79,12 +79,12 @@ pub struct Wavefront {
     dead: std::collections::VecDeque<usize>,
 }
 
-/// Whether a step of `scheme` can run as a wavefront: its passes are the listing with the
-/// summation density, pass A with the EDAC pressure only, and pass B, and nothing between
-/// them reads the whole body (walls, a free surface, a global mean pressure).
-pub fn applies(scheme: &FluidScheme, walls: bool, free_surface: bool) -> bool {
+/// Whether a step of `scheme` (on a fluid with or without `walls`) can run as a wavefront:
+/// its passes are the listing with the summation density, pass A with the EDAC pressure
+/// only, and pass B, and nothing between them reads the whole body (walls, a free surface,
+/// a global mean pressure).
+pub fn applies(scheme: &FluidScheme, walls: bool) -> bool {
     !walls
-        && !free_surface
         && scheme.free_surface.is_none()
         && scheme.density == DensityModel::Summation
         && matches!(scheme.pressure, PressureModel::Edac { .. })
