@@ -800,24 +800,7 @@ paper = "Fig. 14a"
                 csv += &format!("{y},{}\n", y * y - 0.3 * y + err);
             }
             std::fs::write(e.dir.join("centerline_u.csv"), csv).unwrap();
-            Summary {
-                scene: "taylor_green".into(),
-                params: c.params.to_json(),
-                particles: 144,
-                steps: 10,
-                final_time: 1.0,
-                wall_seconds: 0.1,
-                particle_steps_per_second: 1.0,
-                threads: 1,
-                wavefront_steps: 0,
-                status: Status::Completed,
-                reason: None,
-                step: None,
-                metrics: [("l1_velocity_final".to_string(), err)].into(),
-                provenance: Provenance::now(chrono::Utc::now()),
-            }
-            .write(&e.dir)
-            .unwrap();
+            completed(c.params.to_json(), 144, err).write(&e.dir).unwrap();
         }
         let manuscript = root.join("manuscript");
         let section = regenerate(&p, &output, &manuscript).unwrap();
@@ -842,26 +825,40 @@ paper = "Fig. 14a"
 
         // A diverged case is a result without metrics: the claim names it.
         Summary {
-            scene: "taylor_green".into(),
-            params: p.cases[1].params.to_json(),
-            particles: 256,
             steps: 4,
             final_time: 0.19,
-            wall_seconds: 0.1,
-            particle_steps_per_second: 1.0,
-            threads: 1,
-            wavefront_steps: 0,
             status: Status::Diverged,
             reason: Some("NaN".into()),
             step: Some(4),
             metrics: BTreeMap::new(),
-            provenance: Provenance::now(chrono::Utc::now()),
+            ..completed(p.cases[1].params.to_json(), 256, 0.0)
         }
         .write(&e.dir)
         .unwrap();
         let section = regenerate(&p, &output, &manuscript).unwrap();
         let Item::Figure { ours, .. } = &section.items[0] else { panic!() };
         assert!(ours.contains("cannot be judged: diverged before the end time: nx = 16"), "{ours}");
+    }
+
+    /// The summary of a Taylor-Green case of `particles` that completed ten steps to t = 1
+    /// with `l1_velocity_final` = `l1`.
+    fn completed(params: BTreeMap<String, serde_json::Value>, particles: usize, l1: f64) -> Summary {
+        Summary {
+            scene: "taylor_green".into(),
+            params,
+            particles,
+            steps: 10,
+            final_time: 1.0,
+            wall_seconds: 0.1,
+            particle_steps_per_second: 1.0,
+            threads: 1,
+            wavefront_steps: 0,
+            status: Status::Completed,
+            reason: None,
+            step: None,
+            metrics: [("l1_velocity_final".to_string(), l1)].into(),
+            provenance: Provenance::now(chrono::Utc::now()),
+        }
     }
 
     /// A finished case with snapshots at t = 0, 0.5004 and 1.0 (pressure 0, 1, 2 and a
@@ -884,24 +881,7 @@ paper = "Fig. 14a"
             .unwrap();
             series.push(t, &file).unwrap();
         }
-        Summary {
-            scene: "taylor_green".into(),
-            params: p.cases[0].params.to_json(),
-            particles: 4,
-            steps: 10,
-            final_time: 1.0,
-            wall_seconds: 0.1,
-            particle_steps_per_second: 1.0,
-            threads: 1,
-            wavefront_steps: 0,
-            status: Status::Completed,
-            reason: None,
-            step: None,
-            metrics: [("l1_velocity_final".to_string(), 0.1)].into(),
-            provenance: Provenance::now(chrono::Utc::now()),
-        }
-        .write(&e.dir)
-        .unwrap();
+        completed(p.cases[0].params.to_json(), 4, 0.1).write(&e.dir).unwrap();
         e
     }
 
