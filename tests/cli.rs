@@ -53,6 +53,10 @@ fn bad_input_is_refused_naming_key_and_value_and_writes_nothing() {
         ("taylor_green", &["nx=100000"], &["nx", "100000", "indexes"]),
         ("taylor_green", &["nx=60000"], &["nx", "60000", "GiB"]),
         ("dam_break", &["dx=0.00001"], &["dx", "0.00001"]),
+        // A tank's geometry: the key that is off, not the spacing it is measured in.
+        ("dam_break", &["column_height=0.07"], &["column_height", "0.07", "4 particle spacings"]),
+        ("dam_break", &["tank_width=0.5"], &["tank_width", "0.5", "narrower"]),
+        ("hydrostatic_tank", &["width=0.05"], &["width", "0.05", "4 particle spacings"]),
         ("taylor_green_3d", &["nz=4"], &["nz", "4"]),
         ("taylor_green_3d", &["nz=0"], &["nz", "0"]),
         ("no_such_scene", &[], &["no_such_scene"]),

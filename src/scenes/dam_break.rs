@@ -17,13 +17,12 @@
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
-    time_settings, wall_density, wall_from, wall_params, wall_pressure, FluidConstants,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
+    time_settings, wall_params, FluidConstants,
 };
 use super::free_surface_demo::surface_fields;
-use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
+use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -33,9 +32,6 @@ use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-const RHO0: f64 = 1000.0;
-const G: f64 = 9.81;
-const LAYERS: usize = 3;
 const KOSHIZUKA: &str = include_str!("../../reference_data/koshizuka1996_dambreak_toe.csv");
 
 /// The registry entry.
@@ -102,7 +98,7 @@ struct DamBreak {
 /// The constants, kernel, smoothing length and scheme, once every parameter check that
 /// needs no particle has passed.
 fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
-    let (dx, l, hc) = (p.float("dx"), p.float("column_width"), p.float("column_height"));
+    let (l, hc) = (p.float("column_width"), p.float("column_height"));
     let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let bad = |key: &str, why: String| Err(format!("scene `dam_break`: `{key}` = {}: {why}", p.float(key)));
     if tw < l {
@@ -111,16 +107,13 @@ fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), Strin
     if th < hc {
         return bad("tank_height", format!("the tank is lower than the column (column_height = {hc})"));
     }
-    if l < 4.0 * dx || hc < 4.0 * dx {
-        return bad("dx", "the column must be at least 4 particles wide and high".into());
-    }
-    require_free_surface_scheme("dam_break", p)?;
-    let walls = (tw + 2.0 * th) / dx * LAYERS as f64;
-    check_size::<2>("dam_break", "dx", dx, (l / dx) * (hc / dx) + walls)?;
-    let constants = FluidConstants::under_gravity(RHO0, G, hc, dx, p.float("alpha"));
-    let (kernel, h, scheme) = fluid_scheme::<2>("dam_break", p, &constants)?;
-    check_wall_layers("dam_break", p, &kernel, h, dx, LAYERS)?;
-    Ok((constants, kernel, h, scheme))
+    column(p).setup("dam_break", ["column_width", "column_height"], p)
+}
+
+/// The water column in its tank.
+fn column(p: &Params) -> Column {
+    let tank = (p.float("tank_width"), p.float("tank_height"));
+    Column { width: p.float("column_width"), height: p.float("column_height"), tank, dx: p.float("dx") }
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
@@ -132,11 +125,7 @@ fn dam_break(p: &Params) -> Result<DamBreak, String> {
     let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let (constants, kernel, h, scheme) = setup(p)?;
     let (c0, u_ref) = (constants.c0, constants.u_ref);
-    let hydrostatic = |x: &Vector<2>| RHO0 * G * (hc - x[1]);
-    let fluid =
-        fluid_at_rest(lattice(0.0, l, 0.0, hc, dx), dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
-    let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
-        .with_models(wall_density(p), wall_pressure(p));
+    let (fluid, wall) = column(p).bodies(p, h, c0, scheme.transport.is_some())?;
     // Open above and around the tank: the run-up jets are fast (11-19 m/s measured at the
     // impact on the far wall, where the front of Ritter's solution runs at 2 sqrt(g H) =
     // 8.9 m/s), and a drop thrown out of the tank is splash, counted by `particles_lost`,

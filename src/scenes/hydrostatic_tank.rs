@@ -10,24 +10,18 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan,
-    require_free_surface_scheme, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
-    time_settings, wall_density, wall_from, wall_params, wall_pressure, FluidConstants,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
+    time_settings, wall_params, FluidConstants,
 };
-use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
+use super::tank::{Column, G, LAYERS, RHO0};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
-use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-const RHO0: f64 = 1000.0;
-const G: f64 = 9.81;
-const LAYERS: usize = 3;
 
 /// The registry entry.
 pub const ENTRY: SceneEntry = SceneEntry {
@@ -65,33 +59,20 @@ struct Tank {
 /// The constants, kernel, smoothing length and scheme, once every parameter check that
 /// needs no particle has passed.
 fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
-    let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
-    for (key, len) in [("height", height), ("width", width)] {
-        if len < 4.0 * dx {
-            return Err(format!(
-                "scene `hydrostatic_tank`: `{key}` = {len} is less than 4 particle spacings (dx = {dx})"
-            ));
-        }
-    }
-    require_free_surface_scheme("hydrostatic_tank", p)?;
-    let walls = (width + 3.0 * height) / dx * LAYERS as f64;
-    check_size::<2>("hydrostatic_tank", "dx", dx, (width / dx) * (height / dx) + walls)?;
-    let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
-    let (kernel, h, scheme) = fluid_scheme::<2>("hydrostatic_tank", p, &constants)?;
-    check_wall_layers("hydrostatic_tank", p, &kernel, h, dx, LAYERS)?;
-    Ok((constants, kernel, h, scheme))
+    column(p).setup("hydrostatic_tank", ["width", "height"], p)
+}
+
+/// The fluid column in a tank as wide and half as high again.
+fn column(p: &Params) -> Column {
+    let (height, width) = (p.float("height"), p.float("width"));
+    Column { width, height, tank: (width, 1.5 * height), dx: p.float("dx") }
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
     let (constants, kernel, h, scheme) = setup(p)?;
     let c0 = constants.c0;
-    let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);
-    let x = lattice(0.0, width, 0.0, height, dx);
-    let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), hydrostatic)?;
-    let wall =
-        wall_from(&box_walls(width, 1.5 * height, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
-            .with_models(wall_density(p), wall_pressure(p));
+    let (fluid, wall) = column(p).bodies(p, h, c0, scheme.transport.is_some())?;
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
     let time = time_settings(p, c0, constants.u_ref);

@@ -12,6 +12,7 @@ pub mod harness;
 pub mod hydrostatic_tank;
 pub mod params;
 pub mod progress;
+pub mod tank;
 pub mod taylor_green;
 
 use crate::solver::simulation::Divergence;
