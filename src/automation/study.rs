@@ -349,6 +349,21 @@ fn figure(
         ours,
     };
     let caption = if f.caption.is_empty() { f.title.clone() } else { f.caption.clone() };
+    // The figure as curves of `series` against `x_label` (its y label, if not given, the
+    // column `y`), and its item.
+    let lines = |x_label: String, y: &String, series: Vec<Series>| -> Result<Vec<Item>, String> {
+        let y_label = f.y_label.clone().unwrap_or_else(|| y.clone());
+        let fig = report::LineFigure {
+            title: f.title.clone(),
+            x_label,
+            y_label,
+            log_x: false,
+            log_y: f.log_y,
+            series,
+        };
+        report::line_figure(&fig, &stem)?;
+        Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
+    };
     match &f.kind {
         FigureKind::Timeseries { y, exact } => {
             let mut series = Vec::new();
@@ -362,18 +377,7 @@ fn figure(
                 }
                 series.push(Series { label: label(r.case, &f.label), x: t, y: v, style: SeriesStyle::Line });
             }
-            report::line_figure(
-                &report::LineFigure {
-                    title: f.title.clone(),
-                    x_label: "t (s)".into(),
-                    y_label: f.y_label.clone().unwrap_or_else(|| y.clone()),
-                    log_x: false,
-                    log_y: f.log_y,
-                    series,
-                },
-                &stem,
-            )?;
-            Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
+            lines("t (s)".into(), y, series)
         }
         FigureKind::Particles { field, time, arrows } => {
             let at = time.map(|t| format!(" at t = {t} s")).unwrap_or_default();
@@ -447,18 +451,7 @@ fn figure(
                     style: SeriesStyle::Reference,
                 });
             }
-            report::line_figure(
-                &report::LineFigure {
-                    title: f.title.clone(),
-                    x_label: f.x_label.clone().unwrap_or_else(|| x.clone()),
-                    y_label: f.y_label.clone().unwrap_or_else(|| y.clone()),
-                    log_x: false,
-                    log_y: f.log_y,
-                    series,
-                },
-                &stem,
-            )?;
-            Ok(vec![fig_item(&f.id, &caption, ours(f, &rs))])
+            lines(f.x_label.clone().unwrap_or_else(|| x.clone()), y, series)
         }
         FigureKind::Trade { x, spacing } => trade(f, &rs, x, *spacing, figures, tables, &caption),
         FigureKind::Stability { x, max } => stability(f, &rs, x, *max, figures, tables, &caption),
