@@ -48,7 +48,8 @@ impl Column {
         p: &Params,
     ) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
         let Self { width, height, tank: (tw, th), dx } = *self;
-        for (key, len) in keys.into_iter().zip([width, height]) {
+        let [width_key, height_key] = keys;
+        for (key, len) in [(height_key, height), (width_key, width)] {
             if len < 4.0 * dx {
                 return Err(format!(
                     "scene `{scene}`: `{key}` = {len} is less than 4 particle spacings (dx = {dx})"
