@@ -121,11 +121,11 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 }
 
 fn dam_break(p: &Params) -> Result<DamBreak, String> {
-    let (dx, l, hc) = (p.float("dx"), p.float("column_width"), p.float("column_height"));
-    let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let (constants, kernel, h, scheme) = setup(p)?;
     let (c0, u_ref) = (constants.c0, constants.u_ref);
-    let (fluid, wall) = column(p).bodies(p, h, c0, scheme.transport.is_some())?;
+    let column = column(p);
+    let (fluid, wall) = column.bodies(p, h, c0, scheme.transport.is_some())?;
+    let Column { width: l, height: hc, tank: (tw, th), dx } = column;
     // Open above and around the tank: the run-up jets are fast (11-19 m/s measured at the
     // impact on the far wall, where the front of Ritter's solution runs at 2 sqrt(g H) =
     // 8.9 m/s), and a drop thrown out of the tank is splash, counted by `particles_lost`,

@@ -69,12 +69,13 @@ fn column(p: &Params) -> Column {
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
-    let (dx, height, width) = (p.float("dx"), p.float("height"), p.float("width"));
     let (constants, kernel, h, scheme) = setup(p)?;
     let c0 = constants.c0;
-    let (fluid, wall) = column(p).bodies(p, h, c0, scheme.transport.is_some())?;
+    let column = column(p);
+    let (fluid, wall) = column.bodies(p, h, c0, scheme.transport.is_some())?;
+    let Column { width, height, tank: (_, tank_height), dx } = column;
     let edge = (LAYERS as f64 + 0.5) * dx;
-    let domain = Domain::bounded([-edge, -edge], [width + edge, 1.5 * height + edge]);
+    let domain = Domain::bounded([-edge, -edge], [width + edge, tank_height + edge]);
     let time = time_settings(p, c0, constants.u_ref);
     let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
         .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
