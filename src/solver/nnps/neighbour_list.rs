@@ -79,15 +79,6 @@ impl HalfPairs {
         self.entries[span].iter().map(|&e| e & J_MASK)
     }
 
-    /// `values[j]` of every pair of the run, in its order, into `out`: values that stay
-    /// fixed while the pairs are swept several times, gathered once.
-    pub fn gather(&self, values: &[f64], out: &mut Vec<f64>) {
-        out.clear();
-        // The room the list keeps, so that `out` grows only when the list does.
-        out.reserve(self.entries.capacity());
-        out.extend(self.entries.iter().map(|&e| values[(e & J_MASK) as usize]));
-    }
-
     /// The packed entries of point `i`'s pairs `j > i`.
     #[inline(always)]
     fn entries(&self, i: usize) -> &[u32] {
@@ -596,13 +587,8 @@ mod tests {
             let split = pts.len() / 3;
             nl.half_pairs(0..split, &mut first);
             nl.half_pairs(split..pts.len(), &mut second);
-            let values: Vec<f64> = (0..pts.len()).map(|j| 2.0 * j as f64).collect();
-            let (mut first_values, mut second_values) = (Vec::new(), Vec::new());
-            first.gather(&values, &mut first_values);
-            second.gather(&values, &mut second_values);
             for i in 0..pts.len() {
-                let (half, half_values) =
-                    if i < split { (&first, &first_values) } else { (&second, &second_values) };
+                let half = if i < split { &first } else { &second };
                 let mut xij = vec![Vector::zeros(); nl.count(i)];
                 let m = nl.write_half_pairs(half, i, pts[i], &pts, &mut xij);
                 assert_eq!(m, half.count(i));
@@ -611,15 +597,10 @@ mod tests {
                 let mut expected = Vec::new();
                 nl.for_each(i, &pts, |j, x, _, _| {
                     if j > i {
-                        expected.push((j as u32, x, 2.0 * j as f64));
+                        expected.push((j as u32, x));
                     }
                 });
-                let got: Vec<_> = half
-                    .neighbours(span.clone())
-                    .zip(&xij[..m])
-                    .zip(&half_values[span])
-                    .map(|((j, &x), &v)| (j, x, v))
-                    .collect();
+                let got: Vec<_> = half.neighbours(span).zip(xij[..m].iter().copied()).collect();
                 assert_eq!(got, expected, "point {i}");
             }
         }
