@@ -230,7 +230,10 @@ fn colour_bar<DB: DrawingBackend>(
         Rectangle::new([(0.0, v), (1.0, v + step)], c.filled())
     });
     bar.draw_series(cells).map_err(|e| e.to_string())?;
-    let fmt = |v: &f64| canvas::fmt_num(*v);
+    // As the chart axes label their ticks: one computed as lo + k * step that misses zero
+    // by rounding reads 0, not -5.551e-17.
+    let axis = Axis::Linear(lo, hi);
+    let fmt = |v: &f64| axis.format(*v);
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
@@ -280,6 +283,31 @@ mod tests {
         let (xr, yr) = (x.range(), y.range());
         let ratio = ((xr.end - xr.start) / 600.0) / ((yr.end - yr.start) / 300.0);
         assert!((ratio - 1.0).abs() < 1e-12);
+    }
+
+    /// A colour bar symmetric about zero labels its middle tick 0, as the chart axes do,
+    /// however the tick's value rounds (a pressure field read -5.551e-17 there).
+    #[test]
+    fn colour_bar_labels_zero_as_zero() {
+        let dir = tempfile::tempdir().unwrap();
+        let stem = dir.path().join("symmetric");
+        for hi in [0.3347, 0.33, 0.7, 3.3] {
+            let f = ScatterField {
+                title: "symmetric".into(),
+                x: vec![0.0, 1.0, 0.5],
+                y: vec![0.0, 1.0, 0.5],
+                value: vec![-hi, hi, 0.0],
+                value_label: "p [Pa]".into(),
+                range: None,
+                aspect_equal: false,
+                arrows: None,
+            };
+            particle_figure(&f, &stem).unwrap();
+            let svg = check_figure(&stem, (900, 720), &["p [Pa]"]);
+            let labels: Vec<&str> = svg.lines().map(str::trim).filter(|l| l.parse::<f64>().is_ok()).collect();
+            assert!(labels.contains(&"0"), "hi = {hi}: tick labels {labels:?}");
+            assert!(labels.iter().all(|l| l.parse::<f64>().unwrap().abs() > 1e-9 || *l == "0"), "{labels:?}");
+        }
     }
 
     #[test]
