@@ -175,7 +175,8 @@ struct IpstSlab<const D: usize> {
     /// volumes `V_j` from the particles' compact array, not from a copy per pair: the copy
     /// (112 bytes a particle) doubled IPST's memory, and where the step's lists and IPST's
     /// arrays no longer fit the cache together (nx = 180-300 on the host of session 37), the
-    /// passes around the sweeps took 1.4-1.6x their time without IPST, against 1.0-1.3x now.
+    /// passes around the sweeps took 1.4-1.8x their time without IPST, and 1.0-1.5x without
+    /// the copy, from spell to spell (docs/throughput.md, session 37).
     half: HalfPairs,
     pairs: IpstPairs<D>,
     spill: Vec<(u32, Vector<D>, f64)>,
