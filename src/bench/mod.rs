@@ -221,18 +221,19 @@ pub const VARIANTS: &[(&str, &str, &str)] =
 pub const SCHEDULES: &[(&str, Schedule)] =
     &[("/sweeps", Schedule::Sweeps), ("/wavefront", Schedule::Wavefront)];
 
-/// A variant's case and schedule.
-fn split_variant(variant: &str) -> (&str, Schedule) {
-    SCHEDULES
+/// A variant's entry of [`VARIANTS`] (name, scheme, pst) and its schedule, if it is one of
+/// them, optionally with a suffix of [`SCHEDULES`].
+fn lookup_variant(variant: &str) -> Option<(&'static (&'static str, &'static str, &'static str), Schedule)> {
+    let (base, schedule) = SCHEDULES
         .iter()
         .find_map(|&(suffix, s)| variant.strip_suffix(suffix).map(|base| (base, s)))
-        .unwrap_or((variant, Schedule::Tuned))
+        .unwrap_or((variant, Schedule::Tuned));
+    VARIANTS.iter().find(|v| v.0 == base).map(|v| (v, schedule))
 }
 
 /// Whether `variant` is one of [`VARIANTS`], optionally with a suffix of [`SCHEDULES`].
 pub fn known_variant(variant: &str) -> bool {
-    let base = split_variant(variant).0;
-    VARIANTS.iter().any(|v| v.0 == base)
+    lookup_variant(variant).is_some()
 }
 
 fn status_kb(field: &str) -> u64 {
@@ -256,9 +257,8 @@ fn status_kb(field: &str) -> u64 {
 /// A variant may end in a suffix of [`SCHEDULES`]. It is returned after `warmup` untimed
 /// steps, in which a tuned schedule has made its choice.
 fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Result<Simulation<2>, String> {
-    let (base, schedule) = split_variant(variant);
-    let (_, scheme, pst) =
-        VARIANTS.iter().find(|v| v.0 == base).ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
+    let ((_, scheme, pst), schedule) =
+        lookup_variant(variant).ok_or_else(|| format!("unknown bench variant `{variant}`"))?;
     let (nx, scheme, kernel) = (format!("nx={nx}"), format!("scheme={scheme}"), format!("kernel={kernel}"));
     let pst_set = format!("pst={pst}");
     let mut sets =
