@@ -5,6 +5,7 @@ use sphrepro::automation::commands::{self, Dirs, RunFlags};
 use sphrepro::automation::runner;
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
+use sphrepro::solver::simulation::TUNING_STEPS;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -106,10 +107,10 @@ struct BenchArgs {
     /// Thread counts.
     #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2], value_parser = at_least_one::<usize>)]
     bench_threads: Vec<usize>,
-    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps` or `/wavefront` (e.g.
-    /// `edac/sweeps`): the same case with the step's passes one after the other, or tile by
-    /// tile (the same results), to time the two side by side; without, the step takes the
-    /// faster of the two on this host.
+    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps`, `/wavefront` or
+    /// `/narrow` (e.g. `edac/sweeps`): the same case with the step's passes one after the
+    /// other, or tile by tile in wide or narrow tiles (the same results), to time them side
+    /// by side; without, the step takes the fastest on this host.
     #[arg(long, value_delimiter = ',')]
     variants: Option<Vec<String>>,
     /// Timed steps per case (default: about 4 million particle-steps).
@@ -454,8 +455,8 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &s
 }
 
 /// Untimed steps before a bench case is timed: enough for a tuned step schedule to have
-/// timed both of its choices (five steps each) and kept one.
-const BENCH_WARMUP: u64 = 12;
+/// timed its choices and kept one.
+const BENCH_WARMUP: u64 = TUNING_STEPS as u64 + 2;
 
 /// A bench child's result as one JSON line on stdout, or its error on stderr (exit 1).
 fn print_json(r: Result<impl serde::Serialize, String>) -> ExitCode {

@@ -8,7 +8,7 @@
 pub mod targets;
 
 use crate::scenes::taylor_green;
-use crate::solver::simulation::{PhaseTimes, Schedule, Simulation};
+use crate::solver::simulation::{PhaseTimes, Schedule, Simulation, Tiles};
 use crate::solver::warm;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -113,6 +113,10 @@ pub struct BenchResult {
     pub ipst_iterations_mean: f64,
     /// Share of the timed steps spent in each phase.
     pub phase_shares: crate::solver::simulation::PhaseTimes,
+    /// How the last timed step's passes ran ([`schedule_name`]): for a variant without a
+    /// suffix of [`SCHEDULES`], the order the tuner kept.
+    #[serde(default)]
+    pub schedule: String,
     /// Particle-steps per second of every run of this configuration (`bench --repeat`), in
     /// the order they ran; the fields above are those of the median run (see
     /// [`median_runs`]).
@@ -216,10 +220,19 @@ pub const VARIANTS: &[(&str, &str, &str)] =
     &[("edac", "edac", "none"), ("ctvf+sun", "ctvf", "sun"), ("ctvf+ipst", "ctvf", "ipst")];
 
 /// The suffixes of a variant that fix the order of its step's passes (`edac/sweeps`,
-/// `edac/wavefront`: the same results, for timing the two side by side); without one, the
-/// step takes the faster on this host ([`Schedule::Tuned`]).
-pub const SCHEDULES: &[(&str, Schedule)] =
-    &[("/sweeps", Schedule::Sweeps), ("/wavefront", Schedule::Wavefront)];
+/// `edac/wavefront` in wide tiles, `edac/narrow` in narrow ones: the same results, for
+/// timing them side by side); without one, the step takes the fastest on this host
+/// ([`Schedule::Tuned`]).
+pub const SCHEDULES: &[(&str, Schedule)] = &[
+    ("/sweeps", Schedule::Sweeps),
+    ("/wavefront", Schedule::Wavefront(Tiles::Wide)),
+    ("/narrow", Schedule::Wavefront(Tiles::Narrow)),
+];
+
+/// A schedule's name in bench results: its suffix in [`SCHEDULES`] without the slash.
+pub fn schedule_name(schedule: Schedule) -> &'static str {
+    SCHEDULES.iter().find(|s| s.1 == schedule).map_or("tuned", |s| &s.0[1..])
+}
 
 /// A variant's entry of [`VARIANTS`] (name, scheme, pst) and its schedule, if it is one of
 /// them, optionally with a suffix of [`SCHEDULES`].
@@ -284,6 +297,8 @@ struct Timed {
     times: PhaseTimes,
     /// Particle-steps per second of each block of steps.
     runs: Vec<f64>,
+    /// How the last step's passes ran.
+    schedule: Schedule,
 }
 
 impl Timed {
@@ -305,6 +320,7 @@ impl Timed {
         self.steps += steps;
         self.times += sim.times;
         self.runs.push(sim.fluid().len() as f64 * steps as f64 / seconds);
+        self.schedule = sim.last_schedule();
         Ok(())
     }
 
@@ -348,6 +364,7 @@ impl Timed {
         self.ipst += each.iter().map(|t| t.ipst).sum::<usize>();
         self.times += each[0].times.scaled(seconds / each[0].seconds);
         self.runs.push(sims[0].fluid().len() as f64 * all_steps as f64 / seconds);
+        self.schedule = each[0].schedule;
         Ok(())
     }
 
@@ -367,6 +384,7 @@ impl Timed {
             ipst_iterations_mean: self.ipst as f64 / self.steps as f64,
             phase_shares: self.times.scaled(1.0 / self.seconds),
             runs: self.runs,
+            schedule: schedule_name(self.schedule).into(),
         }
     }
 }
@@ -608,14 +626,14 @@ pub fn median_interval(sorted: &[f64]) -> Option<(f64, f64)> {
 /// the peer's end time. Ratios of repeated runs are those of each round (see [`ratio`]).
 pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
-        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up vs 1 thread | IPST iters | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
+        "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up vs 1 thread | IPST iters | step order | time: neighbours/density/pressure/accel/ipst/integrate (%) |",
     );
     if !peers.is_empty() {
         s.push_str(&format!(
             " peer Mparticle-steps/s | ratio to peer | ratio to peer at nx = {FIGURE_TO_BEAT_NX} | L1 at the peer's end time: peer / edac (%) |"
         ));
     }
-    s.push_str("\n|---|---|---|---|---|---|---|---|---|---|---|---|");
+    s.push_str("\n|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     if !peers.is_empty() {
         s.push_str("---|---|---|---|");
     }
@@ -650,7 +668,7 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
         );
         let speed = millions(r.particle_steps_per_second, &r.runs);
         s.push_str(&format!(
-            "| {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {} | {} | {:.2} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.0} | {:.0} | {} | {} | {:.2} | {} | {} |\n",
             r.variant,
             r.nx,
             r.particles,
@@ -662,6 +680,7 @@ pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
             cost,
             speedup,
             r.ipst_iterations_mean,
+            r.schedule,
             shares
         ));
         if !peers.is_empty() {
@@ -726,6 +745,7 @@ mod peer_tests {
             ipst_iterations_mean: 0.0,
             phase_shares: Default::default(),
             runs: Vec::new(),
+            schedule: "sweeps".into(),
         }
     }
 

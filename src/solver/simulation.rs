@@ -5,12 +5,12 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::particles::{Fluid, FluidRates, Wall};
-pub use crate::solver::scheme::Schedule;
 use crate::solver::scheme::{
     build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, wavefront_applies,
     DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, Shifting, StepBodies, SurfaceFields,
     SurfacePressure, Tuner, WallSet, Wavefront,
 };
+pub use crate::solver::scheme::{Schedule, Tiles, TUNING_STEPS};
 use crate::solver::{warm, LIGHT_LOOP_LEN};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -154,6 +154,7 @@ pub struct Simulation<const D: usize> {
     wave: Wavefront,
     schedule: Schedule,
     tuner: Tuner,
+    last_schedule: Schedule,
     wavefront_steps: u64,
     /// Time per phase of the step, summed over the run.
     pub times: PhaseTimes,
@@ -195,6 +196,7 @@ impl<const D: usize> Simulation<D> {
             wave: Wavefront::new(),
             schedule: Schedule::default(),
             tuner: Tuner::default(),
+            last_schedule: Schedule::Sweeps,
             wavefront_steps: 0,
             times: PhaseTimes::default(),
         };
@@ -280,21 +282,57 @@ impl<const D: usize> Simulation<D> {
         self.wavefront_steps
     }
 
-    /// How the step's gather passes are ordered ([`Schedule`]; by default the faster of the
-    /// sweeps and the wavefront on this host). Every schedule gives the same results, bit
-    /// for bit.
+    /// How the last step's gather passes ran: sweeps, or a wavefront in wide or narrow tiles
+    /// (never [`Schedule::Tuned`]).
+    pub fn last_schedule(&self) -> Schedule {
+        self.last_schedule
+    }
+
+    /// How the step's gather passes are ordered ([`Schedule`]; by default the fastest of the
+    /// sweeps and the wavefront in wide or narrow tiles on this host). Every schedule gives
+    /// the same results, bit for bit.
     pub fn set_schedule(&mut self, schedule: Schedule) {
         self.schedule = schedule;
     }
 
-    /// Whether this step's listing and passes can run as a wavefront ([`Wavefront`]): the
-    /// scheme allows it and the body, as binned now, makes enough tiles.
-    fn tiles_planned(&mut self) -> bool {
+    /// How this step's listing and passes run: as the schedule asks, or as the tuner
+    /// picks, where the scheme allows a wavefront ([`Wavefront`]) and the body, as binned
+    /// now, makes enough tiles for it; else as sweeps. Also whether the tuner times the step.
+    fn order(&mut self) -> (Schedule, bool) {
         let st = &self.state;
-        self.schedule != Schedule::Sweeps
+        let allowed = self.schedule != Schedule::Sweeps
             && self.time_settings.rate_positions == RatePositions::End
-            && wavefront_applies(&st.scheme, self.walls.is_some())
-            && self.wave.plan(&self.cells, st.fluid.len())
+            && wavefront_applies(&st.scheme, self.walls.is_some());
+        let n = st.fluid.len();
+        let (wave, cells) = (&mut self.wave, &self.cells);
+        match self.schedule {
+            _ if !allowed => (Schedule::Sweeps, false),
+            Schedule::Wavefront(tiles) if wave.plan(cells, n, tiles) => (self.schedule, false),
+            Schedule::Tuned => {
+                if self.tuner.needs_candidates() {
+                    // The sweeps and each width that makes tiles, once per tiling (on the
+                    // stack: a body too small for tiles asks again every step).
+                    let mut candidates = [Schedule::Sweeps; 3];
+                    let (mut count, mut tilings) = (1, [0; 2]);
+                    for tiles in [Tiles::Wide, Tiles::Narrow] {
+                        if wave.plan(cells, n, tiles) && !tilings[..count - 1].contains(&wave.tiles()) {
+                            tilings[count - 1] = wave.tiles();
+                            candidates[count] = Schedule::Wavefront(tiles);
+                            count += 1;
+                        }
+                    }
+                    if count == 1 {
+                        return (Schedule::Sweeps, false);
+                    }
+                    self.tuner.offer(candidates[..count].to_vec());
+                }
+                match self.tuner.next() {
+                    Schedule::Wavefront(tiles) if !wave.plan(cells, n, tiles) => (Schedule::Sweeps, false),
+                    schedule => (schedule, self.tuner.chosen().is_none()),
+                }
+            }
+            _ => (Schedule::Sweeps, false),
+        }
     }
 
     /// The listing, summation density, pass A over `dt` and pass B of a step as a
@@ -457,7 +495,8 @@ impl<const D: usize> Simulation<D> {
     /// (eqs. 25-26) and their updates (eqs. 56-57) come after the drift, or before it, at
     /// the start positions, as sec. 3.7 orders them ([`RatePositions`]).
     pub fn step(&mut self, max_dt: f64) -> Result<(), Divergence> {
-        let clock = std::time::Instant::now();
+        let step_clock = std::time::Instant::now();
+        let clock = step_clock;
         let dt_nominal = self.nominal_dt();
         let dt = dt_nominal.min(max_dt);
         let rates_at = self.time_settings.rate_positions;
@@ -482,16 +521,12 @@ impl<const D: usize> Simulation<D> {
         lap(clock, &mut self.times.neighbours);
         // The listing and the passes, for the next step (its kick applies the
         // homogenisation acceleration): tile by tile or pass by pass, as the schedule says.
-        let tiled = self.tiles_planned();
-        let wavefront = tiled && (self.schedule == Schedule::Wavefront || self.tuner.wavefront());
-        let clock = std::time::Instant::now();
-        if wavefront {
+        let (schedule, timed) = self.order();
+        self.last_schedule = schedule;
+        if let Schedule::Wavefront(_) = schedule {
             self.wavefront_passes(dt, dt_nominal);
         } else {
             self.swept_passes(dt, dt_nominal);
-        }
-        if tiled && self.schedule == Schedule::Tuned {
-            self.tuner.record(wavefront, clock.elapsed().as_secs_f64());
         }
         self.homogenise(dt_nominal, self.state.steps + 1);
         let clock = std::time::Instant::now();
@@ -501,6 +536,10 @@ impl<const D: usize> Simulation<D> {
         st.steps += 1;
         let result = self.check();
         lap(clock, &mut self.times.integrate);
+        if timed {
+            // The whole step: a schedule also changes what the phases after it find in cache.
+            self.tuner.record(schedule, step_clock.elapsed().as_secs_f64());
+        }
         result
     }
 
@@ -711,27 +750,36 @@ mod tests {
     }
 
     /// The wavefront step sums what the sweeps sum, in the same order: the same state, bit
-    /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one and on two threads. Tiles
-    /// of three chunks cut the 128 x 128 body into ten, so that the first and last meet
-    /// across the periodic edge and the list's storage is handed from tile to tile.
+    /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one and on two threads, in
+    /// wide and narrow tiles, and when the tuner changes the order from block to block.
+    /// Wide tiles of four chunks cut the 128 x 128 body into eight, narrow ones (three
+    /// chunks) into ten, so that the first and last meet across the periodic edge and the
+    /// list's storage is handed from tile to tile.
     #[test]
     fn the_wavefront_step_is_the_sweeps_bit_for_bit() {
         let cases =
             [(SchemeName::Edac, Pst::None), (SchemeName::Ctvf, Pst::Sun), (SchemeName::Ctvf, Pst::Ipst)];
         for (scheme, pst) in cases {
-            let run = |schedule: Schedule, threads: usize| {
+            let run = |schedule: Schedule, threads: usize, steps: usize| {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
                 pool.install(|| {
                     let mut sim = vortex_sized(128, scheme, pst, RatePositions::End);
-                    sim.wave = Wavefront::with_limits(1, 4);
+                    sim.wave = Wavefront::with_limits(4, 4);
                     sim.set_schedule(schedule);
-                    let wavefront = schedule == Schedule::Wavefront;
-                    for _ in 0..4 {
+                    for _ in 0..steps {
                         sim.step(f64::INFINITY).unwrap();
                     }
-                    assert_eq!(sim.wavefront_steps, if wavefront { 4 } else { 0 }, "{scheme:?} {pst:?}");
-                    if wavefront {
-                        assert_eq!(sim.wave.tiles(), 10);
+                    let (waves, tiles) = match schedule {
+                        Schedule::Sweeps => (0..1, None),
+                        // The tuner's blocks of sweeps and of both widths.
+                        Schedule::Tuned => (1..steps, None),
+                        Schedule::Wavefront(Tiles::Wide) => (steps..steps + 1, Some(8)),
+                        Schedule::Wavefront(Tiles::Narrow) => (steps..steps + 1, Some(10)),
+                    };
+                    let ran = sim.wavefront_steps as usize;
+                    assert!(waves.contains(&ran), "{scheme:?} {pst:?} {schedule:?}: {ran} steps tiled");
+                    if let Some(tiles) = tiles {
+                        assert_eq!(sim.wave.tiles(), tiles, "{scheme:?} {pst:?} {schedule:?}");
                     }
                     let f = &sim.state.fluid;
                     let r = &sim.state.rates;
@@ -744,9 +792,17 @@ mod tests {
                     bits
                 })
             };
-            let sweeps = run(Schedule::Sweeps, 1);
-            assert_eq!(run(Schedule::Wavefront, 1), sweeps, "{scheme:?} {pst:?}, one thread");
-            assert_eq!(run(Schedule::Wavefront, 2), sweeps, "{scheme:?} {pst:?}, two threads");
+            let sweeps = run(Schedule::Sweeps, 1, 4);
+            for schedule in [Schedule::Wavefront(Tiles::Wide), Schedule::Wavefront(Tiles::Narrow)] {
+                assert_eq!(run(schedule, 1, 4), sweeps, "{scheme:?} {pst:?} {schedule:?}, one thread");
+                assert_eq!(run(schedule, 2, 4), sweeps, "{scheme:?} {pst:?} {schedule:?}, two threads");
+            }
+            let steps = TUNING_STEPS + 2;
+            assert_eq!(
+                run(Schedule::Tuned, 2, steps),
+                run(Schedule::Sweeps, 1, steps),
+                "{scheme:?} {pst:?}, tuned"
+            );
         }
     }
 }

@@ -34,13 +34,14 @@ use crate::solver::nnps::{CellList, CHUNK};
 use crate::solver::particles::{Fluid, FluidRates};
 use std::ops::Range;
 
-/// The smallest tile, in list chunks (4096 particles). About five tiles of the list are
-/// alive at a time, some 17 MB in 2D: tiles twice as wide lost most of the gain at
-/// nx = 400 on the host that needed it (session 35); the narrowest the reach allows (six
-/// chunks there) were within the noise of these, and fork more parallel loops.
+/// The smallest wide tile ([`Tiles::Wide`]), in list chunks (4096 particles). About five
+/// tiles of the list are alive at a time, some 17 MB in 2D: tiles twice as wide lost most
+/// of the gain at nx = 400 on the host that needed it (session 35); the narrowest the
+/// reach allows (six chunks there) were within the noise of these, and fork more parallel
+/// loops.
 const MIN_TILE_CHUNKS: usize = 8;
-/// The fewest tiles a wavefront step is run with (65 536 particles in 2D, a list three
-/// times the live window). Each stage of a tile is a parallel loop; on two threads their
+/// The fewest tiles a wavefront step is run with (65 536 particles in 2D in wide tiles, a
+/// list three times the live window). Each stage of a tile is a parallel loop; on two threads their
 /// forks and joins made a step at nx = 200 (ten tiles, a list the host's cache held) 5-7 %
 /// slower than the sweeps, while at nx = 400 (39 tiles) the wavefront ran 1.4x faster.
 const MIN_TILES: usize = 16;
@@ -64,7 +65,7 @@ const STAGES: [Stage; 4] = [Stage::List, Stage::Rates, Stage::Update, Stage::Acc
 /// The tiles of a body and the order their stages run in.
 #[derive(Clone, Debug)]
 pub struct Wavefront {
-    /// The smallest tile in chunks, and the fewest tiles.
+    /// The smallest wide tile in chunks, and the fewest tiles.
     limits: (usize, usize),
     /// Tile `k` holds the particles `bounds[k]..bounds[k + 1]`.
     bounds: Vec<usize>,
@@ -103,11 +104,11 @@ impl Wavefront {
         Self::default()
     }
 
-    /// No tiles; the tiles to come at least `min_tile_chunks` chunks wide, and at least
+    /// No tiles; wide tiles to come at least `wide_chunks` chunks wide, and at least
     /// `min_tiles` of them for a wavefront step (tests run small bodies in many tiles).
-    pub(crate) fn with_limits(min_tile_chunks: usize, min_tiles: usize) -> Self {
+    pub(crate) fn with_limits(wide_chunks: usize, min_tiles: usize) -> Self {
         Self {
-            limits: (min_tile_chunks, min_tiles),
+            limits: (wide_chunks, min_tiles),
             bounds: Vec::new(),
             layers: Vec::new(),
             schedule: Vec::new(),
@@ -118,11 +119,16 @@ impl Wavefront {
     }
 
     /// Cuts the `n` particles binned by `cells` (in cell order) into tiles of whole list
-    /// chunks, each at least two cell layers and a chunk wide (and `MIN_TILE_CHUNKS`),
-    /// and checks that every particle's neighbours lie in its tile or the next ones
-    /// (cyclically). Returns whether the body makes at least `MIN_TILES` (16) such tiles.
-    pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize) -> bool {
-        let (min_tile_chunks, min_tiles) = self.limits;
+    /// chunks, each at least two cell layers and a chunk wide (and, for [`Tiles::Wide`],
+    /// `MIN_TILE_CHUNKS`), and checks that every particle's neighbours lie in its tile or
+    /// the next ones (cyclically). Returns whether the body makes at least `MIN_TILES` (16)
+    /// such tiles.
+    pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize, tiles: Tiles) -> bool {
+        let (wide_chunks, min_tiles) = self.limits;
+        let min_tile_chunks = match tiles {
+            Tiles::Wide => wide_chunks,
+            Tiles::Narrow => 1,
+        };
         self.layers.clear();
         for l in 0..cells.layers() {
             let r = cells.layer_points(l..l + 1);
@@ -216,58 +222,123 @@ impl Wavefront {
 /// How a step's gather passes are ordered; the results are the same bit for bit.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Schedule {
-    /// The faster of the other two on this host, timed over the first steps ([`Tuner`]).
+    /// The fastest of the others on this host, timed over the first steps ([`Tuner`]).
     #[default]
     Tuned,
     /// Each pass over the whole body, one after the other.
     Sweeps,
     /// Tile by tile where the scheme and the body allow ([`Wavefront`]), else sweeps.
-    Wavefront,
+    Wavefront(Tiles),
 }
 
-/// Steps each schedule is timed for before [`Tuner`] keeps one.
-const TRIALS: usize = 5;
+/// How wide a wavefront's tiles are cut. Neither is faster everywhere, so the tuner times
+/// both (docs/throughput.md, session 38).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tiles {
+    /// At least `MIN_TILE_CHUNKS` list chunks: fewer parallel loops a step, which two
+    /// threads need (at nx = 300 on the host of session 38 the narrow tiles' listing took
+    /// 1.4x as long as the wide ones' on two threads).
+    Wide,
+    /// The narrowest the reach allows (two cell layers and a chunk): the least of the list
+    /// alive at a time. Where IPST's sweeps share the cache with the list (`ctvf`+`ipst`
+    /// at nx = 200, whose 40 000 particles make too few wide tiles), passes A and B ran
+    /// 1.6x faster in them than in sweeps on one thread, and the step 12 % faster.
+    Narrow,
+}
 
-/// Picks the faster of the sweeps and the wavefront for a body. Which one is faster is a
-/// property of the host: on the host of session 35 the wavefront was 1.45x faster at
-/// nx = 400 but 10 % slower on two threads at nx = 256, where the list still fitted its
-/// cache; on hosts whose memory kept up with the sweeps, only its cost would show. The
-/// first steps alternate between the two, five each, then the one with the shorter
-/// median step is kept. Either gives the same results, so the choice changes only the
-/// speed.
+/// Steps a [`Tuner`] runs a schedule for in a row, and the first of them it does not time:
+/// a schedule pays for its predecessor's state for two or three steps after a change. On
+/// the host of session 38, at nx = 200 on two threads, `edac`'s first steps in narrow tiles
+/// after sweeps ran 10-20 % faster than the ones after them, and the sweeps' first steps
+/// after tiles 10-20 % slower: timed step by step in alternation, the narrow tiles looked
+/// faster than the sweeps, and ran 13 % slower when kept.
+const BLOCK: usize = 6;
+const SETTLE: usize = 3;
+/// Blocks of each schedule before the tuner keeps one, in turn, so that a slow spell of the
+/// host does not fall on one schedule alone.
+const ROUNDS: usize = 2;
+
+/// Steps the tuner takes at most before it keeps a schedule: a block of sweeps untimed (a
+/// run's first steps, which fault its memory in, took up to three times as long as the
+/// later ones), then [`ROUNDS`] blocks of the sweeps and of both widths of tiles.
+pub const TUNING_STEPS: usize = (1 + 3 * ROUNDS) * BLOCK;
+
+/// Picks the fastest of the sweeps and the wavefront's tile widths for a body. Which one
+/// is faster is a property of the host and the scheme: on the host of session 35 the
+/// wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
+/// the list still fitted its cache; on hosts whose memory kept up with the sweeps, only
+/// its cost would show. The first steps go round the candidates in blocks of [`BLOCK`]
+/// steps, [`ROUNDS`] times, then the one with the shortest median timed step (of the last
+/// `BLOCK - SETTLE` steps of each block) is kept.
+/// Each gives the same results, so the choice changes only the speed.
 #[derive(Clone, Debug, Default)]
 pub struct Tuner {
-    /// Seconds of the timed steps, sweeps then wavefront, and how many of each.
-    seconds: [[f64; TRIALS]; 2],
-    timed: [usize; 2],
-    chosen: Option<bool>,
+    /// The schedules timed, sweeps first: empty until the body first makes tiles.
+    candidates: Vec<Schedule>,
+    /// Seconds of each candidate's timed steps.
+    seconds: Vec<Vec<f64>>,
+    /// Steps recorded so far.
+    steps: usize,
+    chosen: Option<Schedule>,
 }
 
 impl Tuner {
-    /// Whether the next step is to run as a wavefront.
-    pub fn wavefront(&self) -> bool {
-        self.chosen.unwrap_or(self.timed[0] > self.timed[1])
+    /// Whether the candidates are still to be offered.
+    pub fn needs_candidates(&self) -> bool {
+        self.candidates.is_empty()
     }
 
-    /// The schedule kept, once the trials are done: `Some(true)` for the wavefront.
-    pub fn chosen(&self) -> Option<bool> {
+    /// The schedules to time, once (later offers are ignored).
+    pub fn offer(&mut self, candidates: Vec<Schedule>) {
+        if self.candidates.is_empty() {
+            self.seconds = vec![Vec::with_capacity(ROUNDS * (BLOCK - SETTLE)); candidates.len()];
+            self.candidates = candidates;
+        }
+    }
+
+    /// The schedule of the next step: the one kept, else the one whose block it is (the
+    /// sweeps in the first, untimed block); sweeps without candidates.
+    pub fn next(&self) -> Schedule {
+        match (self.chosen, self.turn()) {
+            (Some(kept), _) => kept,
+            (None, Some(k)) => self.candidates[k],
+            (None, None) => Schedule::Sweeps,
+        }
+    }
+
+    /// The candidate whose block the next step is in, if it is not the first block.
+    fn turn(&self) -> Option<usize> {
+        (self.steps / BLOCK).checked_sub(1).and_then(|b| b.checked_rem(self.candidates.len()))
+    }
+
+    /// The schedule kept, once the trials are done.
+    pub fn chosen(&self) -> Option<Schedule> {
         self.chosen
     }
 
-    /// Records a step of the passes that took `seconds`, run as a wavefront or not.
-    pub fn record(&mut self, wavefront: bool, seconds: f64) {
-        let k = wavefront as usize;
-        if self.chosen.is_some() || self.timed[k] == TRIALS {
+    /// Records a step that took `seconds` under `schedule` (ignored unless it is
+    /// [`next`](Self::next)'s, while the trials last).
+    pub fn record(&mut self, schedule: Schedule, seconds: f64) {
+        if self.chosen.is_some() || self.candidates.is_empty() || schedule != self.next() {
             return;
         }
-        self.seconds[k][self.timed[k]] = seconds;
-        self.timed[k] += 1;
-        if self.timed == [TRIALS; 2] {
-            let median = |mut t: [f64; TRIALS]| {
+        if let Some(k) = self.turn() {
+            if self.steps % BLOCK >= SETTLE {
+                self.seconds[k].push(seconds);
+            }
+        }
+        self.steps += 1;
+        if self.steps == (1 + ROUNDS * self.candidates.len()) * BLOCK {
+            // In place: the step allocates nothing.
+            let median = |t: &mut Vec<f64>| {
                 t.sort_by(f64::total_cmp);
-                t[TRIALS / 2]
+                (t[(t.len() - 1) / 2] + t[t.len() / 2]) / 2.0
             };
-            self.chosen = Some(median(self.seconds[1]) < median(self.seconds[0]));
+            let best = (0..self.candidates.len())
+                .map(|k| (k, median(&mut self.seconds[k])))
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(k, _)| k);
+            self.chosen = best.map(|k| self.candidates[k]);
         }
     }
 }
@@ -424,7 +495,7 @@ mod tests {
                 let mut list = NeighbourList::<2>::new();
                 list.build(&cells, &x, |_, _| {});
                 let mut w = Wavefront::with_limits(1, 4);
-                if !w.plan(&cells, n) {
+                if !w.plan(&cells, n, Tiles::Narrow) {
                     continue;
                 }
                 planned += 1;
@@ -455,37 +526,66 @@ mod tests {
         assert!(planned >= 9 && refused >= 3, "the test needs bodies that make tiles ({planned}, {refused})");
     }
 
-    /// The tuner alternates, sweeps first, until each schedule has its trials, then keeps
-    /// the one with the shorter median step: one slow step does not decide.
+    /// The tuner runs a block of sweeps untimed, then goes round its candidates in blocks,
+    /// sweeps first, leaving each block's first steps untimed, and keeps the one with the
+    /// shortest median timed step: neither a change's transient nor one slow step decides.
+    /// Without candidates it runs the sweeps and keeps nothing.
     #[test]
-    fn the_tuner_keeps_the_schedule_with_the_shorter_median_step() {
-        let mut t = Tuner::default();
-        let mut order = Vec::new();
-        // The wavefront's steps take 1.0 s but for one of 9 s; the sweeps' take 1.5 s.
-        let wave = [1.0, 9.0, 1.0, 1.0, 1.0];
-        let (mut w, mut s) = (0, 0);
-        while t.chosen().is_none() {
-            let on = t.wavefront();
-            order.push(on);
-            if on {
-                t.record(true, wave[w]);
-                w += 1;
-            } else {
-                t.record(false, 1.5);
-                s += 1;
+    fn the_tuner_keeps_the_schedule_with_the_shortest_median_settled_step() {
+        let (wide, narrow) = (Schedule::Wavefront(Tiles::Wide), Schedule::Wavefront(Tiles::Narrow));
+        let tune = |narrow_settled: f64| {
+            let mut t = Tuner::default();
+            assert!(t.needs_candidates());
+            assert_eq!(t.next(), Schedule::Sweeps);
+            t.record(Schedule::Sweeps, 1.0);
+            assert_eq!(t.chosen(), None, "nothing timed without candidates");
+            t.offer(vec![Schedule::Sweeps, wide, narrow]);
+            assert!(!t.needs_candidates());
+            let (mut order, mut at) = (Vec::new(), 0);
+            while t.chosen().is_none() {
+                let s = t.next();
+                // The step's place in its block: the transient of a change lasts SETTLE steps.
+                let settled =
+                    order.last() == Some(&s) && order.iter().rev().take_while(|&&o| o == s).count() >= SETTLE;
+                let seconds = match s {
+                    _ if at < BLOCK => 5.0, // the run's first steps
+                    Schedule::Sweeps if settled => 1.0,
+                    Schedule::Sweeps => 3.0,
+                    _ if s == wide => 1.2,
+                    _ if !settled => 0.1,
+                    // one slow step among the narrow tiles' settled ones
+                    _ if order.iter().filter(|&&o| o == narrow).count() == BLOCK - 1 => 9.0,
+                    _ => narrow_settled,
+                };
+                t.record(s, seconds);
+                order.push(s);
+                at += 1;
             }
-        }
-        assert_eq!(order, [false, true].repeat(TRIALS));
-        assert_eq!((w, s, t.chosen()), (TRIALS, TRIALS, Some(true)));
-        assert!(t.wavefront());
-        t.record(false, 0.1);
-        assert_eq!(t.chosen(), Some(true), "kept once chosen");
+            let mut expected = vec![Schedule::Sweeps; BLOCK];
+            for _ in 0..ROUNDS {
+                for s in [Schedule::Sweeps, wide, narrow] {
+                    expected.extend([s; BLOCK]);
+                }
+            }
+            assert_eq!(order, expected);
+            assert_eq!(order.len(), TUNING_STEPS);
+            t
+        };
+        let mut t = tune(1.4);
+        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "the narrow tiles' fast first steps do not decide");
+        let t2 = tune(0.9);
+        assert_eq!(t2.chosen(), Some(narrow), "one slow step does not decide");
+        assert_eq!(t2.next(), narrow);
+        t.record(narrow, 0.01);
+        t.offer(vec![narrow]);
+        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "kept once chosen");
         let mut slow = Tuner::default();
-        for _ in 0..TRIALS {
-            slow.record(false, 1.0);
-            slow.record(true, 1.2);
+        slow.offer(vec![Schedule::Sweeps, wide]);
+        while slow.chosen().is_none() {
+            slow.record(narrow, 0.1);
+            let s = slow.next();
+            slow.record(s, if s == wide { 1.2 } else { 1.0 });
         }
-        assert_eq!(slow.chosen(), Some(false));
-        assert!(!slow.wavefront());
+        assert_eq!(slow.chosen(), Some(Schedule::Sweeps), "only candidates count");
     }
 }
