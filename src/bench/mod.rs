@@ -390,7 +390,7 @@ impl Timed {
 }
 
 /// Runs one configuration in this process: `warmup` untimed steps of
-/// [`case_simulation`], then `steps` timed ones.
+/// `case_simulation`, then `steps` timed ones.
 pub fn run_case(
     variant: &str,
     nx: usize,
@@ -623,7 +623,7 @@ pub fn median_interval(sorted: &[f64]) -> Option<(f64, f64)> {
 /// peer's run at [`FIGURE_TO_BEAT_NX`] on the same threads (the issue states one figure to
 /// beat, PySPH at nx = 50, and targets multiples of it at every size; this column reads the targets that
 /// way, the one before it against the peer at each size), and both L1 velocity errors at
-/// the peer's end time. Ratios of repeated runs are those of each round (see [`ratio`]).
+/// the peer's end time. Ratios of repeated runs are those of each round (see `ratio`).
 pub fn table(results: &[BenchResult], peers: &[PeerResult]) -> String {
     let mut s = String::from(
         "| variant | nx | particles | threads | steps | Mparticle-steps/s | ns/particle-step | bytes/particle | cost vs edac | speed-up vs 1 thread | IPST iters | step order | time: neighbours/density/pressure/accel/ipst/integrate (%) |",

@@ -30,7 +30,7 @@ use std::time::{Duration, Instant};
 /// pollers told to stop as they start.
 ///
 /// Between tasks the pollers spin, giving the CPU back to the operating system every
-/// [`SPINS_PER_YIELD`] polls, so that a machine running more threads than cores still
+/// `SPINS_PER_YIELD` polls, so that a machine running more threads than cores still
 /// gives its time to the work. They cost a core each while `f` runs serial code.
 pub fn keep_warm<R>(f: impl FnOnce() -> R) -> R {
     let Some(me) = rayon::current_thread_index() else {

@@ -66,7 +66,7 @@ impl HalfPairs {
     }
 
     /// Where point `i`'s pairs `j > i` sit among all the pairs of the run (in the order of
-    /// [`neighbours`](Self::neighbours) and [`gather`](Self::gather)).
+    /// [`neighbours`](Self::neighbours)).
     #[inline(always)]
     pub fn span(&self, i: usize) -> std::ops::Range<usize> {
         let l = i - self.first;
@@ -476,7 +476,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
 
     /// As [`write_pairs`](Self::write_pairs) over the pairs `j > i` of point `i` listed in
     /// `half` (by [`half_pairs`](Self::half_pairs)), the differences `x_ij` only (the
-    /// neighbours are [`HalfPairs::neighbours`], their values [`HalfPairs::gather`]).
+    /// neighbours are [`HalfPairs::neighbours`]).
     /// Returns how many were written.
     #[inline(always)]
     pub fn write_half_pairs(

@@ -24,7 +24,7 @@ use rayon::prelude::*;
 /// Particles per rayon task: large enough that scheduling is noise.
 pub(super) const MIN_LEN: usize = 128;
 
-/// The neighbour list of a fluid body: each pair carries its [`PairKernel`], evaluated once
+/// The neighbour list of a fluid body: each pair carries its `PairKernel`, evaluated once
 /// per step when the list is built.
 pub type KernelList<const D: usize> = NeighbourList<D, PairKernel>;
 

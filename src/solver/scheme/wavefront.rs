@@ -260,15 +260,15 @@ const ROUNDS: usize = 2;
 
 /// Steps the tuner takes at most before it keeps a schedule: a block of sweeps untimed (a
 /// run's first steps, which fault its memory in, took up to three times as long as the
-/// later ones), then [`ROUNDS`] blocks of the sweeps and of both widths of tiles.
+/// later ones), then `ROUNDS` blocks of the sweeps and of both widths of tiles.
 pub const TUNING_STEPS: usize = (1 + 3 * ROUNDS) * BLOCK;
 
 /// Picks the fastest of the sweeps and the wavefront's tile widths for a body. Which one
 /// is faster is a property of the host and the scheme: on the host of session 35 the
 /// wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
 /// the list still fitted its cache; on hosts whose memory kept up with the sweeps, only
-/// its cost would show. The first steps go round the candidates in blocks of [`BLOCK`]
-/// steps, [`ROUNDS`] times, then the one with the shortest median timed step (of the last
+/// its cost would show. The first steps go round the candidates in blocks of `BLOCK`
+/// steps, `ROUNDS` times, then the one with the shortest median timed step (of the last
 /// `BLOCK - SETTLE` steps of each block) is kept.
 /// Each gives the same results, so the choice changes only the speed.
 #[derive(Clone, Debug, Default)]
