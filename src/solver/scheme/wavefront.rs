@@ -22,8 +22,9 @@
 //! Every particle's sums are the same sums, over the same neighbours in the same order, as
 //! in the sweeps one after the other; only the order in which particles are visited
 //! changes. The results are bit for bit those of the sweeps, on any number of threads
-//! (tested). Which of the two is faster depends on the host's cache, so by default a run
-//! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
+//! (tested). Which is faster, the sweeps or the wavefront in wide or narrow tiles
+//! ([`Tiles`]), depends on the host's cache, the scheme and the threads, so by default a
+//! run times each on its first steps and keeps the fastest ([`Schedule`], [`Tuner`]).
 
 use super::passes::{
     build_kernel_chunks_summing_density, pressure_rates, shifting_dt, writes_homogenisation, RateTerms,
