@@ -42,9 +42,10 @@ use std::ops::Range;
 /// loops.
 const MIN_TILE_CHUNKS: usize = 8;
 /// The fewest tiles a wavefront step is run with (65 536 particles in 2D in wide tiles, a
-/// list three times the live window). Each stage of a tile is a parallel loop; on two threads their
-/// forks and joins made a step at nx = 200 (ten tiles, a list the host's cache held) 5-7 %
-/// slower than the sweeps, while at nx = 400 (39 tiles) the wavefront ran 1.4x faster.
+/// list three times the live window). Each stage of a tile is a parallel loop; on two
+/// threads their forks and joins made a step at nx = 200 (ten tiles, a list the host's
+/// cache held) 5-7 % slower than the sweeps, while at nx = 400 (39 tiles) the wavefront ran
+/// 1.4x faster.
 const MIN_TILES: usize = 16;
 
 /// A stage of a tile, in the order they run on it.
@@ -247,8 +248,9 @@ pub enum Tiles {
     Narrow,
 }
 
-/// Steps a [`Tuner`] runs a schedule for in a row, and the first of them it does not time:
-/// a schedule pays for its predecessor's state for two or three steps after a change. On
+/// Steps a [`Tuner`] runs a schedule for in a row (`BLOCK`), and how many of the first of
+/// them it does not time (`SETTLE`): a schedule pays for its predecessor's state for two
+/// or three steps after a change. On
 /// the host of session 38, at nx = 200 on two threads, `edac`'s first steps in narrow tiles
 /// after sweeps ran 10-20 % faster than the ones after them, and the sweeps' first steps
 /// after tiles 10-20 % slower: timed step by step in alternation, the narrow tiles looked
@@ -331,7 +333,7 @@ impl Tuner {
         self.steps += 1;
         if self.steps == (1 + ROUNDS * self.candidates.len()) * BLOCK {
             // In place: the step allocates nothing.
-            let median = |t: &mut Vec<f64>| {
+            let median = |t: &mut [f64]| {
                 t.sort_by(f64::total_cmp);
                 (t[(t.len() - 1) / 2] + t[t.len() / 2]) / 2.0
             };
