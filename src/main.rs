@@ -107,10 +107,10 @@ struct BenchArgs {
     /// Thread counts.
     #[arg(long = "bench-threads", value_delimiter = ',', default_values_t = vec![1usize, 2], value_parser = at_least_one::<usize>)]
     bench_threads: Vec<usize>,
-    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps`, `/wavefront` or
-    /// `/narrow` (e.g. `edac/sweeps`): the same case with the step's passes one after the
-    /// other, or tile by tile in wide or narrow tiles (the same results), to time them side
-    /// by side; without, the step takes the fastest on this host.
+    /// Variants (edac, ctvf+sun, ctvf+ipst); each may end in `/sweeps` or `/wavefront`
+    /// (e.g. `edac/sweeps`): the same case with the step's passes one after the other, or
+    /// tile by tile (the same results), to time them side by side; without, the step takes
+    /// the faster on this host.
     #[arg(long, value_delimiter = ',')]
     variants: Option<Vec<String>>,
     /// Timed steps per case (default: about 4 million particle-steps).

@@ -8,7 +8,7 @@
 pub mod targets;
 
 use crate::scenes::taylor_green;
-use crate::solver::simulation::{PhaseTimes, Schedule, Simulation, Tiles};
+use crate::solver::simulation::{PhaseTimes, Schedule, Simulation};
 use crate::solver::warm;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
@@ -220,14 +220,10 @@ pub const VARIANTS: &[(&str, &str, &str)] =
     &[("edac", "edac", "none"), ("ctvf+sun", "ctvf", "sun"), ("ctvf+ipst", "ctvf", "ipst")];
 
 /// The suffixes of a variant that fix the order of its step's passes (`edac/sweeps`,
-/// `edac/wavefront` in wide tiles, `edac/narrow` in narrow ones: the same results, for
-/// timing them side by side); without one, the step takes the fastest on this host
-/// ([`Schedule::Tuned`]).
-pub const SCHEDULES: &[(&str, Schedule)] = &[
-    ("/sweeps", Schedule::Sweeps),
-    ("/wavefront", Schedule::Wavefront(Tiles::Wide)),
-    ("/narrow", Schedule::Wavefront(Tiles::Narrow)),
-];
+/// `edac/wavefront`: the same results, for timing them side by side); without one, the
+/// step takes the faster on this host ([`Schedule::Tuned`]).
+pub const SCHEDULES: &[(&str, Schedule)] =
+    &[("/sweeps", Schedule::Sweeps), ("/wavefront", Schedule::Wavefront)];
 
 /// A schedule's name in bench results: its suffix in [`SCHEDULES`] without the slash.
 pub fn schedule_name(schedule: Schedule) -> &'static str {

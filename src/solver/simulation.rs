@@ -10,7 +10,7 @@ use crate::solver::scheme::{
     DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, Shifting, StepBodies, SurfaceFields,
     SurfacePressure, Tuner, WallSet, Wavefront,
 };
-pub use crate::solver::scheme::{Schedule, Tiles, TUNING_STEPS};
+pub use crate::solver::scheme::{Schedule, TUNING_STEPS};
 use crate::solver::{warm, LIGHT_LOOP_LEN};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -282,15 +282,15 @@ impl<const D: usize> Simulation<D> {
         self.wavefront_steps
     }
 
-    /// How the last step's gather passes ran: sweeps, or a wavefront in wide or narrow tiles
-    /// (never [`Schedule::Tuned`]).
+    /// How the last step's gather passes ran: sweeps or a wavefront (never
+    /// [`Schedule::Tuned`]).
     pub fn last_schedule(&self) -> Schedule {
         self.last_schedule
     }
 
-    /// How the step's gather passes are ordered ([`Schedule`]; by default the fastest of the
-    /// sweeps and the wavefront in wide or narrow tiles on this host). Every schedule gives
-    /// the same results, bit for bit.
+    /// How the step's gather passes are ordered ([`Schedule`]; by default the faster of the
+    /// sweeps and the wavefront on this host). Every schedule gives the same results, bit
+    /// for bit.
     pub fn set_schedule(&mut self, schedule: Schedule) {
         self.schedule = schedule;
     }
@@ -307,27 +307,17 @@ impl<const D: usize> Simulation<D> {
         let (wave, cells) = (&mut self.wave, &self.cells);
         match self.schedule {
             _ if !allowed => (Schedule::Sweeps, false),
-            Schedule::Wavefront(tiles) if wave.plan(cells, n, tiles) => (self.schedule, false),
+            Schedule::Wavefront if wave.plan(cells, n) => (self.schedule, false),
             Schedule::Tuned => {
                 if self.tuner.needs_candidates() {
-                    // The sweeps and each width that makes tiles, once per tiling (on the
-                    // stack: a body too small for tiles asks again every step).
-                    let mut candidates = [Schedule::Sweeps; 3];
-                    let (mut count, mut tilings) = (1, [0; 2]);
-                    for tiles in [Tiles::Wide, Tiles::Narrow] {
-                        if wave.plan(cells, n, tiles) && !tilings[..count - 1].contains(&wave.tiles()) {
-                            tilings[count - 1] = wave.tiles();
-                            candidates[count] = Schedule::Wavefront(tiles);
-                            count += 1;
-                        }
-                    }
-                    if count == 1 {
+                    // Once the body makes tiles (one too small for them asks every step).
+                    if !wave.plan(cells, n) {
                         return (Schedule::Sweeps, false);
                     }
-                    self.tuner.offer(candidates[..count].to_vec());
+                    self.tuner.offer(vec![Schedule::Sweeps, Schedule::Wavefront]);
                 }
                 match self.tuner.next() {
-                    Schedule::Wavefront(tiles) if !wave.plan(cells, n, tiles) => (Schedule::Sweeps, false),
+                    Schedule::Wavefront if !wave.plan(cells, n) => (Schedule::Sweeps, false),
                     schedule => (schedule, self.tuner.chosen().is_none()),
                 }
             }
@@ -523,7 +513,7 @@ impl<const D: usize> Simulation<D> {
         // homogenisation acceleration): tile by tile or pass by pass, as the schedule says.
         let (schedule, timed) = self.order();
         self.last_schedule = schedule;
-        if let Schedule::Wavefront(_) = schedule {
+        if schedule == Schedule::Wavefront {
             self.wavefront_passes(dt, dt_nominal);
         } else {
             self.swept_passes(dt, dt_nominal);
@@ -750,10 +740,10 @@ mod tests {
     }
 
     /// The wavefront step sums what the sweeps sum, in the same order: the same state, bit
-    /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one and on two threads, in
-    /// wide and narrow tiles, and when the tuner changes the order from block to block.
-    /// Wide tiles of four chunks cut the 128 x 128 body into eight, narrow ones (three
-    /// chunks) into ten, so that the first and last meet across the periodic edge and the
+    /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one, two and three threads
+    /// (each its wave over a region of the tiles), and when the tuner changes the order
+    /// from block to block. Tiles of three chunks cut the 128 x 128 body into ten, so that
+    /// the first and last meet across the periodic edge, and the regions' ends meet, and the
     /// list's storage is handed from tile to tile.
     #[test]
     fn the_wavefront_step_is_the_sweeps_bit_for_bit() {
@@ -764,17 +754,15 @@ mod tests {
                 let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
                 pool.install(|| {
                     let mut sim = vortex_sized(128, scheme, pst, RatePositions::End);
-                    sim.wave = Wavefront::with_limits(4, 4);
                     sim.set_schedule(schedule);
                     for _ in 0..steps {
                         sim.step(f64::INFINITY).unwrap();
                     }
                     let (waves, tiles) = match schedule {
                         Schedule::Sweeps => (0..1, None),
-                        // The tuner's blocks of sweeps and of both widths.
+                        // The tuner's blocks of sweeps and of tiles.
                         Schedule::Tuned => (1..steps, None),
-                        Schedule::Wavefront(Tiles::Wide) => (steps..steps + 1, Some(8)),
-                        Schedule::Wavefront(Tiles::Narrow) => (steps..steps + 1, Some(10)),
+                        Schedule::Wavefront => (steps..steps + 1, Some(10)),
                     };
                     let ran = sim.wavefront_steps as usize;
                     assert!(waves.contains(&ran), "{scheme:?} {pst:?} {schedule:?}: {ran} steps tiled");
@@ -793,9 +781,12 @@ mod tests {
                 })
             };
             let sweeps = run(Schedule::Sweeps, 1, 4);
-            for schedule in [Schedule::Wavefront(Tiles::Wide), Schedule::Wavefront(Tiles::Narrow)] {
-                assert_eq!(run(schedule, 1, 4), sweeps, "{scheme:?} {pst:?} {schedule:?}, one thread");
-                assert_eq!(run(schedule, 2, 4), sweeps, "{scheme:?} {pst:?} {schedule:?}, two threads");
+            for threads in 1..=3 {
+                assert_eq!(
+                    run(Schedule::Wavefront, threads, 4),
+                    sweeps,
+                    "{scheme:?} {pst:?}, {threads} threads"
+                );
             }
             let steps = TUNING_STEPS + 2;
             assert_eq!(

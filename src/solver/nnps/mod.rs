@@ -19,7 +19,7 @@ pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
 /// The implementations of the list build's distance test (same bits; the fastest is used).
 pub use filter::Path as DistanceTest;
-pub use neighbour_list::{HalfPairs, Listed, NeighbourList, PairSlices, CHUNK};
+pub use neighbour_list::{ChunkWriter, HalfPairs, Listed, NeighbourList, PairSlices, CHUNK};
 pub use slabs::{PerPoint, Slabs};
 
 use crate::solver::math::Vector;

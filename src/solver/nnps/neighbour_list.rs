@@ -122,6 +122,13 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
         self.r2.clear();
     }
 
+    /// Hands this chunk's payload storage to `next` and takes `next`'s
+    /// ([`NeighbourList::recycle`]).
+    fn hand_payload_to(&mut self, next: &mut Self) {
+        std::mem::swap(&mut self.payload, &mut next.payload);
+        self.payload_stale = true;
+    }
+
     /// The number of pairs listed.
     fn pairs(&self) -> usize {
         self.start.last().map_or(0, |&end| end as usize)
@@ -246,9 +253,11 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     /// in cache, rather than into memory last touched a build ago. `dead` keeps its pairs
     /// ([`half_pairs`](Self::half_pairs) still reads them); a query of its payloads panics.
     pub fn recycle(&mut self, dead: usize, next: usize) {
-        let payload = std::mem::take(&mut self.chunks[dead].payload);
-        self.chunks[dead].payload = std::mem::replace(&mut self.chunks[next].payload, payload);
-        self.chunks[dead].payload_stale = true;
+        assert_ne!(dead, next, "two chunks");
+        let (lo, hi) = self.chunks.split_at_mut(dead.max(next));
+        let (low, high) = (&mut lo[dead.min(next)], &mut hi[0]);
+        let (dead, next) = if dead < next { (low, high) } else { (high, low) };
+        dead.hand_payload_to(next);
     }
 
     /// Lists the points of `chunks` (after [`begin`](Self::begin)), as
@@ -263,63 +272,16 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         out: &mut [R],
         reduce: impl Fn(Listed<'_, P>) -> R + Sync,
     ) {
-        let n = points.len();
-        assert_eq!(n, self.sources, "the points of `begin`");
-        assert_eq!(out.len(), (chunks.end * CHUNK).min(n) - chunks.start * CHUNK, "one reduction per point");
-        let shifts = &self.shifts;
-        let r2max = cells.radius2();
-        let path = filter::Path::fastest();
-        let first = chunks.start;
-        self.chunks[chunks].par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().for_each(
-            |(c, (chunk, out))| {
-                let c = first + c;
-                // The entries and payload keep their length (the room of the last build):
-                // they only grow, so that no point's room is zeroed before it is written.
-                chunk.start.clear();
-                chunk.payload_stale = false;
-                let mut len = 0;
-                // Points are visited in cell order, so the candidates of a cell serve every
-                // point in it.
-                let mut current = usize::MAX;
-                for (i, out) in (c * CHUNK..((c + 1) * CHUNK).min(n)).zip(out) {
-                    let cell = cells.cell_of(i);
-                    if cell != current {
-                        current = cell;
-                        chunk.gather_candidates(cells, cell, points, shifts);
-                    }
-                    let first = len;
-                    chunk.start.push(first as u32);
-                    let m = chunk.candidates.len();
-                    // Room for every candidate plus one vector of lanes past the last.
-                    grow(&mut chunk.entries, first + m + filter::LANES);
-                    chunk.r2.resize(m + filter::LANES, 0.0);
-                    let c = filter::Candidates {
-                        entries: &chunk.candidates,
-                        x: &chunk.candidate_x,
-                        shift: &chunk.candidate_shift,
-                    };
-                    let accepted = filter::within(
-                        path,
-                        &points[i],
-                        &c,
-                        r2max,
-                        filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
-                    );
-                    len = first + accepted;
-                    // The payload over whole vectors: the pairs padded with copies of the search
-                    // radius, whose values are then dropped (a scalar tail loop would cost as
-                    // much as the vector body).
-                    let padded = accepted.next_multiple_of(filter::LANES);
-                    chunk.r2[accepted..padded].fill(r2max);
-                    grow(&mut chunk.payload, first + padded);
-                    payload(&chunk.r2[..padded], &mut chunk.payload[first..first + padded]);
-                    let (entries, payload) = (&chunk.entries[first..len], &chunk.payload[first..len]);
-                    *out = reduce(Listed { entries, payload });
-                }
-                chunk.start.push(len as u32);
-                chunk.keep_headroom();
-            },
-        );
+        let into = ChunkRun { chunks: &mut self.chunks[chunks.clone()], first: chunks.start, split: 1 };
+        list_chunks(into, &self.shifts, self.sources, cells, points, payload, out, reduce);
+    }
+
+    /// After [`begin`](Self::begin): a writer through which several threads list disjoint
+    /// runs of chunks at once while others read the list's other points through `&self`
+    /// (a step run as a wavefront over tiles on several threads). It borrows nothing: the
+    /// caller answers for the list outliving it and for its chunks not being resized.
+    pub fn chunk_writer(&mut self) -> ChunkWriter<D, P> {
+        ChunkWriter { chunks: self.chunks.as_mut_ptr(), len: self.chunks.len() }
     }
 
     /// Lists, for every query point, its neighbours among `sources` (binned by `cells`),
@@ -528,6 +490,148 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
                     + c.payload.capacity() * std::mem::size_of::<P>()
             })
             .sum()
+    }
+}
+
+/// A run of a list's chunks, from chunk `first` on, to list in rayon tasks of at least
+/// `split` chunks.
+struct ChunkRun<'a, const D: usize, P> {
+    chunks: &'a mut [Chunk<D, P>],
+    first: usize,
+    split: usize,
+}
+
+/// Lists the points of the chunks of `into` among `points`, as
+/// [`NeighbourList::build_chunks`] does (`shifts` and `sources` are the list's).
+#[allow(clippy::too_many_arguments)]
+fn list_chunks<const D: usize, P: Copy + Default + Send + Sync, R: Send>(
+    into: ChunkRun<'_, D, P>,
+    shifts: &[Vector<D>],
+    sources: usize,
+    cells: &CellList<D>,
+    points: &[Vector<D>],
+    payload: impl Fn(&[f64], &mut [P]) + Sync,
+    out: &mut [R],
+    reduce: impl Fn(Listed<'_, P>) -> R + Sync,
+) {
+    let n = points.len();
+    let ChunkRun { chunks, first, split } = into;
+    assert_eq!(n, sources, "the points of `begin`");
+    let last = first + chunks.len();
+    assert_eq!(out.len(), (last * CHUNK).min(n) - first * CHUNK, "one reduction per point");
+    let r2max = cells.radius2();
+    let path = filter::Path::fastest();
+    chunks.par_iter_mut().zip(out.par_chunks_mut(CHUNK)).enumerate().with_min_len(split).for_each(
+        |(c, (chunk, out))| {
+            let c = first + c;
+            // The entries and payload keep their length (the room of the last build):
+            // they only grow, so that no point's room is zeroed before it is written.
+            chunk.start.clear();
+            chunk.payload_stale = false;
+            let mut len = 0;
+            // Points are visited in cell order, so the candidates of a cell serve every
+            // point in it.
+            let mut current = usize::MAX;
+            for (i, out) in (c * CHUNK..((c + 1) * CHUNK).min(n)).zip(out) {
+                let cell = cells.cell_of(i);
+                if cell != current {
+                    current = cell;
+                    chunk.gather_candidates(cells, cell, points, shifts);
+                }
+                let first = len;
+                chunk.start.push(first as u32);
+                let m = chunk.candidates.len();
+                // Room for every candidate plus one vector of lanes past the last.
+                grow(&mut chunk.entries, first + m + filter::LANES);
+                chunk.r2.resize(m + filter::LANES, 0.0);
+                let c = filter::Candidates {
+                    entries: &chunk.candidates,
+                    x: &chunk.candidate_x,
+                    shift: &chunk.candidate_shift,
+                };
+                let accepted = filter::within(
+                    path,
+                    &points[i],
+                    &c,
+                    r2max,
+                    filter::Accepted { entries: &mut chunk.entries[first..], r2: &mut chunk.r2 },
+                );
+                len = first + accepted;
+                // The payload over whole vectors: the pairs padded with copies of the search
+                // radius, whose values are then dropped (a scalar tail loop would cost as
+                // much as the vector body).
+                let padded = accepted.next_multiple_of(filter::LANES);
+                chunk.r2[accepted..padded].fill(r2max);
+                grow(&mut chunk.payload, first + padded);
+                payload(&chunk.r2[..padded], &mut chunk.payload[first..first + padded]);
+                let (entries, payload) = (&chunk.entries[first..len], &chunk.payload[first..len]);
+                *out = reduce(Listed { entries, payload });
+            }
+            chunk.start.push(len as u32);
+            chunk.keep_headroom();
+        },
+    );
+}
+
+/// Lists runs of a [`NeighbourList`]'s chunks from several threads at once (see
+/// [`NeighbourList::chunk_writer`]).
+pub struct ChunkWriter<const D: usize, P> {
+    chunks: *mut Chunk<D, P>,
+    len: usize,
+}
+
+// SAFETY: a writer hands out chunks only through its unsafe methods, whose callers keep
+// the threads' chunks apart.
+unsafe impl<const D: usize, P: Send> Send for ChunkWriter<D, P> {}
+unsafe impl<const D: usize, P: Send> Sync for ChunkWriter<D, P> {}
+
+impl<const D: usize, P: Copy + Default + Send + Sync> ChunkWriter<D, P> {
+    /// The chunks `run`, for this thread alone.
+    ///
+    /// # Safety
+    /// `run` is within the list; no other thread touches these chunks until the returned
+    /// borrow ends, and the list is alive and not resized meanwhile.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn run(&self, run: std::ops::Range<usize>) -> &mut [Chunk<D, P>] {
+        assert!(run.start <= run.end && run.end <= self.len, "chunks {run:?} of {}", self.len);
+        // SAFETY: in bounds (checked) and exclusive (the caller's contract).
+        unsafe { std::slice::from_raw_parts_mut(self.chunks.add(run.start), run.len()) }
+    }
+
+    /// As [`NeighbourList::build_chunks`] on `list`, the list this writer was made from,
+    /// in one task on the calling thread.
+    ///
+    /// # Safety
+    /// While it runs, no other thread reads or writes the chunks `chunks` (their points'
+    /// neighbours), and `list` is the writer's list, [`begin`](NeighbourList::begin)
+    /// since the writer was made.
+    #[allow(clippy::too_many_arguments)]
+    pub unsafe fn build_chunks<R: Send>(
+        &self,
+        list: &NeighbourList<D, P>,
+        cells: &CellList<D>,
+        points: &[Vector<D>],
+        payload: impl Fn(&[f64], &mut [P]) + Sync,
+        chunks: std::ops::Range<usize>,
+        out: &mut [R],
+        reduce: impl Fn(Listed<'_, P>) -> R + Sync,
+    ) {
+        assert!(std::ptr::eq(list.chunks.as_ptr(), self.chunks), "the writer's own list");
+        // SAFETY: the caller's contract.
+        let into =
+            ChunkRun { chunks: unsafe { self.run(chunks.clone()) }, first: chunks.start, split: usize::MAX };
+        list_chunks(into, &list.shifts, list.sources, cells, points, payload, out, reduce);
+    }
+
+    /// As [`NeighbourList::recycle`].
+    ///
+    /// # Safety
+    /// While it runs, no other thread reads or writes chunks `dead` or `next`.
+    pub unsafe fn recycle(&self, dead: usize, next: usize) {
+        assert_ne!(dead, next, "two chunks");
+        // SAFETY: the caller's contract; two distinct chunks.
+        let (dead, next) = unsafe { (&mut self.run(dead..dead + 1)[0], &mut self.run(next..next + 1)[0]) };
+        dead.hand_payload_to(next);
     }
 }
 

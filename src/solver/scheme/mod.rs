@@ -18,7 +18,7 @@ pub use ipst::ipst_chi_reference;
 pub use passes::{build_kernel_list, build_kernel_list_summing_density, FluidPasses, KernelList};
 pub use walls::WallSet;
 pub use wavefront::{
-    applies as wavefront_applies, Schedule, StageTimes, StepBodies, Tiles, Tuner, Wavefront, TUNING_STEPS,
+    applies as wavefront_applies, Schedule, StageTimes, StepBodies, Tuner, Wavefront, TUNING_STEPS,
 };
 
 use serde::{Deserialize, Serialize};

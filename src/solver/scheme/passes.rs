@@ -16,7 +16,7 @@ use crate::solver::equations::{
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
-use crate::solver::nnps::{CellList, NeighbourList};
+use crate::solver::nnps::{CellList, Listed, NeighbourList};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -71,28 +71,32 @@ pub fn build_kernel_list_summing_density<const D: usize>(
 ) {
     rho.resize(fluid.len(), 0.0);
     let chunks = nl.begin(cells, fluid.len());
-    build_kernel_chunks_summing_density(nl, cells, fluid, k, chunks, rho);
+    let list = KernelAndDensity::new(fluid, k);
+    nl.build_chunks(cells, &fluid.x, |r2, out| list.payload(r2, out), chunks, rho, |p| list.density(p));
 }
 
-/// As [`build_kernel_list_summing_density`] for the points of `chunks` only (after
-/// [`NeighbourList::begin`]), their densities in `rho` from the first chunk's first point.
-pub(super) fn build_kernel_chunks_summing_density<const D: usize>(
-    nl: &mut KernelList<D>,
-    cells: &CellList<D>,
-    fluid: &Fluid<D>,
-    k: &Kernel,
-    chunks: std::ops::Range<usize>,
-    rho: &mut [f64],
-) {
-    let (k, m) = (k.scaled(fluid.h), &fluid.m);
-    nl.build_chunks(
-        cells,
-        &fluid.x,
-        |r2, out| kernel_payload(&k, r2, out),
-        chunks,
-        rho,
-        |pairs| pairs.iter().fold(0.0, |s, (j, kw)| s + m[j] * kw.w),
-    );
+/// What a fluid's list build computes for each pair, its [`PairKernel`] from the pair's
+/// squared distance, and for each particle as its pairs are listed, the fluid's share of
+/// its summation density.
+pub(super) struct KernelAndDensity<'a> {
+    k: ScaledKernel,
+    m: &'a [f64],
+}
+
+impl<'a> KernelAndDensity<'a> {
+    pub(super) fn new<const D: usize>(fluid: &'a Fluid<D>, k: &Kernel) -> Self {
+        Self { k: k.scaled(fluid.h), m: &fluid.m }
+    }
+
+    /// The payloads of the pairs at squared distances `r2`.
+    pub(super) fn payload(&self, r2: &[f64], out: &mut [PairKernel]) {
+        kernel_payload(&self.k, r2, out);
+    }
+
+    /// `sum_b m_b W_ab` over a particle's pairs.
+    pub(super) fn density(&self, pairs: Listed<'_, PairKernel>) -> f64 {
+        pairs.iter().fold(0.0, |s, (j, kw)| s + self.m[j] * kw.w)
+    }
 }
 
 /// Builds the list of the neighbours of `queries` (a body of smoothing length `h`) among
@@ -130,6 +134,44 @@ fn gather_points<const D: usize>(f: &Fluid<D>, out: &mut Vec<Point<D>>) {
     let u_hat = f.u_hat();
     out.resize(f.len(), point(f, u_hat, 0));
     out.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, p)| *p = point(f, u_hat, i));
+}
+
+/// Sets the density and pressure of the particles from `first` on (one per element of
+/// `points`, `rho` and `p`) with `set(i, rho_i, p_i)` and gathers their views anew from
+/// `fluid`'s other fields, in rayon tasks of at least `task_len` particles.
+pub(super) fn set_and_regather<const D: usize>(
+    fluid: FluidViews<'_, D>,
+    first: usize,
+    (points, rho, p): (&mut [Point<D>], &mut [f64], &mut [f64]),
+    set: impl Fn(usize, &mut f64, &mut f64) + Sync,
+    task_len: usize,
+) {
+    let FluidViews { u, u_hat, m } = fluid;
+    points
+        .par_iter_mut()
+        .zip(rho.par_iter_mut().zip(p.par_iter_mut()))
+        .enumerate()
+        .with_min_len(task_len)
+        .for_each(|(k, (pt, (rho, p)))| {
+            let i = first + k;
+            set(i, rho, p);
+            *pt = Point::new(u[i], u_hat[i], m[i], *rho, *p);
+        });
+}
+
+/// The fields of a fluid its particles' views are gathered from besides the density and
+/// the pressure.
+#[derive(Clone, Copy)]
+pub(super) struct FluidViews<'a, const D: usize> {
+    u: &'a [Vector<D>],
+    u_hat: &'a [Vector<D>],
+    m: &'a [f64],
+}
+
+impl<'a, const D: usize> FluidViews<'a, D> {
+    pub(super) fn of(f: &'a Fluid<D>) -> Self {
+        Self { u: &f.u, u_hat: f.u_hat(), m: &f.m }
+    }
 }
 
 /// The wall particles as the fluid sees them: with the slip ghost velocities of eqs.
@@ -228,30 +270,6 @@ impl<const D: usize> FluidPasses<D> {
         }
     }
 
-    /// Sets the density and pressure of the particles `range` with `set(i, rho_i, p_i)` and
-    /// gathers their views anew, in one parallel loop.
-    pub(super) fn set_and_regather(
-        &mut self,
-        fluid: &mut Fluid<D>,
-        range: std::ops::Range<usize>,
-        set: impl Fn(usize, &mut f64, &mut f64) + Sync,
-    ) {
-        let Fluid { u, u_hat, m, rho, p, .. } = fluid;
-        let u_hat = u_hat.as_deref().unwrap_or(u);
-        let (u, m, first) = (&u[..], &m[..], range.start);
-        self.points.resize(u.len(), Point::new(u[0], u_hat[0], m[0], rho[0], p[0]));
-        self.points[range.clone()]
-            .par_iter_mut()
-            .zip(rho[range.clone()].par_iter_mut().zip(p[range].par_iter_mut()))
-            .enumerate()
-            .with_min_len(MIN_LEN)
-            .for_each(|(k, (pt, (rho, p)))| {
-                let i = first + k;
-                set(i, rho, p);
-                *pt = Point::new(u[i], u_hat[i], m[i], *rho, *p);
-            });
-    }
-
     /// Summation density, `rho_a = sum_b m_b W_ab` over the fluid and the walls: the
     /// fluid's share `fluid_sums` (summed as the list was built), then the walls'.
     pub fn summation_density(fluid: &mut Fluid<D>, fluid_sums: &[f64], walls: Option<&WallSet<D>>) {
@@ -292,7 +310,7 @@ impl<const D: usize> FluidPasses<D> {
                     .enumerate()
                     .with_min_len(MIN_LEN)
                     .for_each(|(i, (dp, drho))| (*dp, *drho) = rate(i)),
-                (true, false) => pressure_rates(&terms, &src, 0, &mut rates.dp),
+                (true, false) => pressure_rates(&terms, &src, 0, &mut rates.dp, MIN_LEN),
                 (false, _) => rates
                     .drho
                     .par_iter_mut()
@@ -338,11 +356,12 @@ impl<const D: usize> FluidPasses<D> {
         self.gather(fluid, nl, walls);
         rates.a_c_dt = shifting_dt(s, dt);
         let a_c = if writes_homogenisation(s) { &mut rates.a_c[..] } else { &mut [] };
-        self.write_accelerations(fluid, nl, walls, surface, s, dt, 0, &mut rates.du, a_c);
+        self.write_accelerations(fluid, nl, walls, surface, s, dt, 0, &mut rates.du, a_c, MIN_LEN);
     }
 
     /// Pass B over the gathered points, for the particles from `first` on: one per element
-    /// of `du`, with their homogenisation accelerations in `a_c` unless it is empty.
+    /// of `du`, with their homogenisation accelerations in `a_c` unless it is empty, in
+    /// rayon tasks of at least `task_len` particles.
     #[allow(clippy::too_many_arguments)]
     pub(super) fn write_accelerations(
         &self,
@@ -355,6 +374,7 @@ impl<const D: usize> FluidPasses<D> {
         first: usize,
         du: &mut [Vector<D>],
         a_c: &mut [Vector<D>],
+        task_len: usize,
     ) {
         let src = self.sources(fluid, nl, walls);
         let g = s.gravity_vector::<D>();
@@ -385,12 +405,12 @@ impl<const D: usize> FluidPasses<D> {
             (acc + g, ac)
         };
         if a_c.is_empty() {
-            du.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(k, du)| *du = rate(first + k).0);
+            du.par_iter_mut().enumerate().with_min_len(task_len).for_each(|(k, du)| *du = rate(first + k).0);
         } else {
             du.par_iter_mut()
                 .zip(a_c.par_iter_mut())
                 .enumerate()
-                .with_min_len(MIN_LEN)
+                .with_min_len(task_len)
                 .for_each(|(k, (du, ac))| (*du, *ac) = rate(first + k));
         }
     }
@@ -411,15 +431,16 @@ pub(super) fn writes_homogenisation(s: &FluidScheme) -> bool {
 }
 
 /// Pass A's EDAC pressure rates (eq. 26) of the particles from `first` on, one per element
-/// of `dp`, without the continuity equation.
+/// of `dp`, without the continuity equation, in rayon tasks of at least `task_len`.
 pub(super) fn pressure_rates<const D: usize>(
     terms: &RateTerms,
     src: &Sources<'_, D>,
     first: usize,
     dp: &mut [f64],
+    task_len: usize,
 ) {
     let rate = |i: usize| with_rates_plan!(terms.plan, P => terms.sums::<P, D>(src, i)).0;
-    dp.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(k, dp)| *dp = rate(first + k));
+    dp.par_iter_mut().enumerate().with_min_len(task_len).for_each(|(k, dp)| *dp = rate(first + k));
 }
 
 /// The terms of pass A a scheme declares: its plan and the EDAC constants.

@@ -12,41 +12,48 @@
 //! of a tile then needs only the previous stage done on the tile and its two neighbours,
 //! and the stages run one tile behind each other: listing tile t, pass A on tile t - 1,
 //! the pressure update on tile t - 2, pass B on tile t - 3. Only about four tiles of the
-//! list are alive at a time. Once a tile's pass B has run its payloads (the kernel values,
-//! 24 of a pair's 28 bytes) are dead, and their storage goes to the next tile listed, so
-//! that the listing writes into memory still in cache rather than into memory last
-//! touched a step ago: without that hand-over the wavefront took 12 % off a step at
-//! nx = 400, with it 32 % (one thread; the same as at nx = 200). The pairs themselves stay,
-//! for IPST's sweeps after the step.
+//! list are alive at a time. The tiles are the narrowest the reach allows: the less of the
+//! list is alive, the more of it stays in cache beside what else the step keeps there
+//! (IPST's work space: in `ctvf`+`ipst` at nx = 200, passes A and B ran 1.6x faster in
+//! such tiles than in sweeps on one thread, session 38). Once a tile's pass B has run its
+//! payloads (the kernel values, 24 of a pair's 28 bytes) are dead, and their storage goes
+//! to the next tile listed, so that the listing writes into memory still in cache rather
+//! than into memory last touched a step ago: without that hand-over the wavefront took
+//! 12 % off a step at nx = 400, with it 32 % (one thread; the same as at nx = 200). The
+//! pairs themselves stay, for IPST's sweeps after the step.
 //!
 //! Every particle's sums are the same sums, over the same neighbours in the same order, as
 //! in the sweeps one after the other; only the order in which particles are visited
 //! changes. The results are bit for bit those of the sweeps, on any number of threads
-//! (tested). Which is faster, the sweeps or the wavefront in wide or narrow tiles
-//! ([`Tiles`]), depends on the host's cache, the scheme and the threads, so by default a
-//! run times each on its first steps and keeps the fastest ([`Schedule`], [`Tuner`]).
+//! (tested).
+//!
+//! On several threads each thread runs a wave of its own over a region of the tiles, a
+//! stage of a tile at a time, and waits for another only where a stage needs one of its
+//! tiles ([`Board`]). A stage forks no parallel loop: when each stage of each tile was one,
+//! their forks and joins (some eighty a step at nx = 200) made the narrow tiles 13 % slower
+//! than the sweeps on two threads (session 38). Which is faster, the sweeps or the
+//! wavefront, depends on the host's cache, the scheme and the threads, so by default a run
+//! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
 
 use super::passes::{
-    build_kernel_chunks_summing_density, pressure_rates, shifting_dt, writes_homogenisation, RateTerms,
+    pressure_rates, set_and_regather, shifting_dt, writes_homogenisation, FluidViews, KernelAndDensity,
+    RateTerms,
 };
 use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference};
+use crate::solver::equations::Point;
 use crate::solver::kernel::Kernel;
 use crate::solver::nnps::{CellList, CHUNK};
 use crate::solver::particles::{Fluid, FluidRates};
+use std::collections::VecDeque;
 use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
+use std::time::Instant;
 
-/// The smallest wide tile ([`Tiles::Wide`]), in list chunks (4096 particles). About five
-/// tiles of the list are alive at a time, some 17 MB in 2D: tiles twice as wide lost most
-/// of the gain at nx = 400 on the host that needed it (session 35); the narrowest the
-/// reach allows (six chunks there) were within the noise of these, and fork more parallel
-/// loops.
-const MIN_TILE_CHUNKS: usize = 8;
-/// The fewest tiles a wavefront step is run with (65 536 particles in 2D in wide tiles, a
-/// list three times the live window). Each stage of a tile is a parallel loop; on two
-/// threads their forks and joins made a step at nx = 200 (ten tiles, a list the host's
-/// cache held) 5-7 % slower than the sweeps, while at nx = 400 (39 tiles) the wavefront ran
-/// 1.4x faster.
-const MIN_TILES: usize = 16;
+/// The fewest tiles a wavefront step is run with: a wave needs a few tiles to run in (two
+/// threads' waves, a few each), and a body that makes fewer has a list the cache holds.
+/// From nx = 100 in 2D (six tiles); whether the wavefront pays there is the tuner's to
+/// find (`ctvf`+`ipst` ran 5-8 % faster in it on one thread on the host of session 39).
+const MIN_TILES: usize = 4;
 
 /// A stage of a tile, in the order they run on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -65,21 +72,14 @@ enum Stage {
 const STAGES: [Stage; 4] = [Stage::List, Stage::Rates, Stage::Update, Stage::Accelerations];
 
 /// The tiles of a body and the order their stages run in.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Wavefront {
-    /// The smallest wide tile in chunks, and the fewest tiles.
-    limits: (usize, usize),
     /// Tile `k` holds the particles `bounds[k]..bounds[k + 1]`.
     bounds: Vec<usize>,
     /// The start of every non-empty cell layer, then the number of particles.
     layers: Vec<usize>,
-    /// The stages in the order they run, for `schedule_tiles` tiles.
-    schedule: Vec<(Stage, usize)>,
-    schedule_tiles: usize,
-    /// Scratch: the stages done on each tile,
-    level: Vec<u8>,
-    /// and the tiles whose lists are no longer read, in the order their pass B ran.
-    dead: std::collections::VecDeque<usize>,
+    /// The workers' shared state during a step.
+    board: Board,
 }
 
 /// Whether a step of `scheme` (on a fluid with or without `walls`) can run as a wavefront:
@@ -94,43 +94,17 @@ pub fn applies(scheme: &FluidScheme, walls: bool) -> bool {
         && scheme.pressure_reference != PressureReference::GlobalMean
 }
 
-impl Default for Wavefront {
-    fn default() -> Self {
-        Self::with_limits(MIN_TILE_CHUNKS, MIN_TILES)
-    }
-}
-
 impl Wavefront {
     /// No tiles.
     pub fn new() -> Self {
         Self::default()
     }
 
-    /// No tiles; wide tiles to come at least `wide_chunks` chunks wide, and at least
-    /// `min_tiles` of them for a wavefront step (tests run small bodies in many tiles).
-    pub(crate) fn with_limits(wide_chunks: usize, min_tiles: usize) -> Self {
-        Self {
-            limits: (wide_chunks, min_tiles),
-            bounds: Vec::new(),
-            layers: Vec::new(),
-            schedule: Vec::new(),
-            schedule_tiles: 0,
-            level: Vec::new(),
-            dead: Default::default(),
-        }
-    }
-
     /// Cuts the `n` particles binned by `cells` (in cell order) into tiles of whole list
-    /// chunks, each at least two cell layers and a chunk wide (and, for [`Tiles::Wide`],
-    /// `MIN_TILE_CHUNKS`), and checks that every particle's neighbours lie in its tile or
-    /// the next ones (cyclically). Returns whether the body makes at least `MIN_TILES` (16)
-    /// such tiles.
-    pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize, tiles: Tiles) -> bool {
-        let (wide_chunks, min_tiles) = self.limits;
-        let min_tile_chunks = match tiles {
-            Tiles::Wide => wide_chunks,
-            Tiles::Narrow => 1,
-        };
+    /// chunks, each at least two cell layers and a chunk wide, and checks that every
+    /// particle's neighbours lie in its tile or the next ones (cyclically). Returns whether
+    /// the body makes at least `MIN_TILES` (4) such tiles.
+    pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize) -> bool {
         self.layers.clear();
         for l in 0..cells.layers() {
             let r = cells.layer_points(l..l + 1);
@@ -144,9 +118,9 @@ impl Wavefront {
             return false;
         }
         let widest_pair = self.layers.windows(3).map(|w| w[2] - w[0]).max().unwrap_or(n);
-        let width = (widest_pair.div_ceil(CHUNK) + 1).max(min_tile_chunks) * CHUNK;
+        let width = (widest_pair.div_ceil(CHUNK) + 1) * CHUNK;
         let tiles = n / width;
-        if tiles < min_tiles.max(1) {
+        if tiles < MIN_TILES {
             return false;
         }
         self.bounds.clear();
@@ -186,39 +160,6 @@ impl Wavefront {
     fn range(&self, k: usize) -> Range<usize> {
         self.bounds[k]..self.bounds[k + 1]
     }
-
-    /// Orders the stages: the deepest stage that is ready, else the next tile's listing
-    /// (the last tile first, which the first tile's passes read across a periodic edge). A
-    /// stage is ready on a tile when the stage before it is done on the tile and on both
-    /// tiles next to it. Kept while the number of tiles does not change.
-    fn order_stages(&mut self) {
-        let n = self.tiles();
-        if self.schedule_tiles != n {
-            self.schedule.clear();
-            self.level.clear();
-            self.level.resize(n, 0);
-            let level = &mut self.level;
-            let ready = |level: &[u8], k: usize, s: usize| {
-                level[k] as usize == s
-                    && level[(k + 1) % n] as usize >= s
-                    && level[(k + n - 1) % n] as usize >= s
-            };
-            let mut listed = 0;
-            while self.schedule.len() < STAGES.len() * n {
-                debug_assert!(listed <= n, "some stage is ready while tiles are left");
-                let next = (1..STAGES.len())
-                    .rev()
-                    .find_map(|s| (0..n).find(|&k| ready(level, k, s)).map(|k| (s, k)));
-                let (s, k) = next.unwrap_or_else(|| {
-                    listed += 1;
-                    (0, (listed + n - 2) % n)
-                });
-                level[k] += 1;
-                self.schedule.push((STAGES[s], k));
-            }
-            self.schedule_tiles = n;
-        }
-    }
 }
 
 /// How a step's gather passes are ordered; the results are the same bit for bit.
@@ -230,43 +171,27 @@ pub enum Schedule {
     /// Each pass over the whole body, one after the other.
     Sweeps,
     /// Tile by tile where the scheme and the body allow ([`Wavefront`]), else sweeps.
-    Wavefront(Tiles),
-}
-
-/// How wide a wavefront's tiles are cut. Neither is faster everywhere, so the tuner times
-/// both (docs/throughput.md, session 38).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Tiles {
-    /// At least `MIN_TILE_CHUNKS` list chunks: fewer parallel loops a step, which two
-    /// threads need (at nx = 300 on the host of session 38 the narrow tiles' listing took
-    /// 1.4x as long as the wide ones' on two threads).
-    Wide,
-    /// The narrowest the reach allows (two cell layers and a chunk): the least of the list
-    /// alive at a time. Where IPST's sweeps share the cache with the list (`ctvf`+`ipst`
-    /// at nx = 200, whose 40 000 particles make too few wide tiles), passes A and B ran
-    /// 1.6x faster in them than in sweeps on one thread, and the step 12 % faster.
-    Narrow,
+    Wavefront,
 }
 
 /// Steps a [`Tuner`] runs a schedule for in a row (`BLOCK`), and how many of the first of
 /// them it does not time (`SETTLE`): a schedule pays for its predecessor's state for two
-/// or three steps after a change. On
-/// the host of session 38, at nx = 200 on two threads, `edac`'s first steps in narrow tiles
-/// after sweeps ran 10-20 % faster than the ones after them, and the sweeps' first steps
-/// after tiles 10-20 % slower: timed step by step in alternation, the narrow tiles looked
-/// faster than the sweeps, and ran 13 % slower when kept.
+/// or three steps after a change. On the host of session 38, at nx = 200 on two threads,
+/// `edac`'s first steps in tiles after sweeps ran 10-20 % faster than the ones after them,
+/// and the sweeps' first steps after tiles 10-20 % slower: timed step by step in
+/// alternation, the tiles looked faster than the sweeps, and ran 13 % slower when kept.
 const BLOCK: usize = 6;
 const SETTLE: usize = 3;
 /// Blocks of each schedule before the tuner keeps one, in turn, so that a slow spell of the
 /// host does not fall on one schedule alone.
-const ROUNDS: usize = 2;
+const ROUNDS: usize = 3;
 
 /// Steps the tuner takes at most before it keeps a schedule: a block of sweeps untimed (a
 /// run's first steps, which fault its memory in, took up to three times as long as the
-/// later ones), then `ROUNDS` blocks of the sweeps and of both widths of tiles.
-pub const TUNING_STEPS: usize = (1 + 3 * ROUNDS) * BLOCK;
+/// later ones), then `ROUNDS` blocks of the sweeps and of the wavefront.
+pub const TUNING_STEPS: usize = (1 + 2 * ROUNDS) * BLOCK;
 
-/// Picks the fastest of the sweeps and the wavefront's tile widths for a body. Which one
+/// Picks the faster of the sweeps and the wavefront for a body. Which one
 /// is faster is a property of the host and the scheme: on the host of session 35 the
 /// wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
 /// the list still fitted its cache; on hosts whose memory kept up with the sweeps, only
@@ -364,7 +289,8 @@ pub struct StepBodies<'a, const D: usize> {
     pub rates: &'a mut FluidRates<D>,
 }
 
-/// Seconds spent listing, in pass A and the update, and in pass B.
+/// Seconds spent listing, in pass A and the update, and in pass B: the threads' time in
+/// each, scaled to add up to the step's.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct StageTimes {
     /// Listing and summation density.
@@ -375,10 +301,244 @@ pub struct StageTimes {
     pub accelerations: f64,
 }
 
+impl StageTimes {
+    fn add(&mut self, stage: Stage, seconds: f64) {
+        match stage {
+            Stage::List => self.list += seconds,
+            Stage::Rates | Stage::Update => self.pressure += seconds,
+            Stage::Accelerations => self.accelerations += seconds,
+        }
+    }
+
+    fn scaled(self, to: f64) -> Self {
+        let f = to / (self.list + self.pressure + self.accelerations).max(f64::MIN_POSITIVE);
+        Self { list: self.list * f, pressure: self.pressure * f, accelerations: self.accelerations * f }
+    }
+}
+
+/// A stage of a tile taken by a worker, and for a listing the tile whose list storage it
+/// takes over.
+#[derive(Clone, Copy, Debug)]
+struct Task {
+    stage: Stage,
+    tile: usize,
+    dead: Option<usize>,
+}
+
+/// What the workers of a wavefront step share, under a mutex: the stages done and taken
+/// on each tile, and the tiles whose lists are dead. Kept in the [`Wavefront`] from step to
+/// step, so that a step allocates nothing.
+///
+/// Each worker owns a region, a run of tiles with about as many particles as the others',
+/// and runs its stages as one thread runs them all: the deepest stage that is ready first,
+/// else the listing of the next tile, the region's last tile first (the next region's
+/// first passes read it) and then from its first on. A stage on the tile next to it then
+/// finds the tile's list and views still in its own core's cache. A worker takes stages of
+/// other regions only once its own are all taken, or while some region's worker has not
+/// started (on a pool whose other threads are busy, one worker runs them all).
+#[derive(Clone, Debug, Default)]
+struct Board {
+    /// Stages done on each tile,
+    done: Vec<u8>,
+    /// and taken by a worker (done or running).
+    taken: Vec<u8>,
+    /// The tiles of each worker's region.
+    regions: Vec<Range<usize>>,
+    /// Workers started.
+    started: usize,
+    /// Stages done in all.
+    finished: usize,
+    /// For each region, its tiles whose lists are no longer read, in the order their pass B
+    /// ended (their storage, last touched by the region's core, goes to its next listing).
+    dead: Vec<VecDeque<usize>>,
+    /// The threads' seconds in each kind of stage.
+    times: StageTimes,
+    /// Whether a stage panicked: the other workers then stop.
+    failed: bool,
+}
+
+impl Board {
+    /// Readies the board for a step over `bounds` (the tiles' first particles, then the
+    /// number of particles) on `workers` threads.
+    fn reset(&mut self, bounds: &[usize], workers: usize) {
+        let tiles = bounds.len() - 1;
+        for v in [&mut self.done, &mut self.taken] {
+            v.clear();
+            v.resize(tiles, 0);
+        }
+        // A tile belongs to the region its middle particle falls in.
+        let n = bounds[tiles];
+        let region_of = |k: usize| ((bounds[k] + bounds[k + 1]) / 2 * workers / n.max(1)).min(workers - 1);
+        self.regions.clear();
+        self.regions.extend((0..workers).map(|w| {
+            let first = (0..tiles).find(|&k| region_of(k) >= w).unwrap_or(tiles);
+            let end = (first..tiles).find(|&k| region_of(k) > w).unwrap_or(tiles);
+            first..end
+        }));
+        self.dead.resize_with(workers, VecDeque::new);
+        self.dead.iter_mut().for_each(VecDeque::clear);
+        (self.started, self.finished, self.failed) = (0, 0, false);
+        self.times = StageTimes::default();
+    }
+
+    /// Stages in all.
+    fn stages(&self) -> usize {
+        STAGES.len() * self.done.len()
+    }
+
+    /// Whether stage `s` of tile `k` can start: it is not taken, and the stage before it
+    /// is done on the tile and on both tiles next to it (cyclically).
+    fn ready(&self, s: usize, k: usize) -> bool {
+        let n = self.done.len();
+        self.taken[k] as usize == s
+            && self.done[k] as usize == s
+            && self.done[(k + 1) % n] as usize >= s
+            && self.done[(k + n - 1) % n] as usize >= s
+    }
+
+    /// The stage worker `w` runs next, now taken; `None` if it is to wait.
+    fn take(&mut self, w: usize) -> Option<Task> {
+        let own = self.regions[w].clone();
+        let (stage, tile) = self.pick(own.clone()).or_else(|| {
+            let roam = self.started < self.regions.len()
+                || own.clone().all(|k| self.taken[k] as usize == STAGES.len());
+            roam.then(|| self.pick(0..self.done.len())).flatten()
+        })?;
+        self.taken[tile] += 1;
+        let region = self.regions.iter().position(|r| r.contains(&tile)).unwrap_or(w);
+        let dead = if stage == Stage::List { self.dead[region].pop_front() } else { None };
+        Some(Task { stage, tile, dead })
+    }
+
+    /// The stage one thread would run next among `tiles`: the deepest that is ready, on
+    /// the first tile it is ready on; else the listing of the last tile, or of the first
+    /// one not listed.
+    fn pick(&self, tiles: Range<usize>) -> Option<(Stage, usize)> {
+        let deepest = (1..STAGES.len())
+            .rev()
+            .find_map(|s| tiles.clone().find(|&k| self.ready(s, k)).map(|k| (STAGES[s], k)));
+        deepest.or_else(|| {
+            let last = tiles.end.checked_sub(1).filter(|_| !tiles.is_empty())?;
+            std::iter::once(last)
+                .chain(tiles.start..last)
+                .find(|&k| self.ready(0, k))
+                .map(|k| (Stage::List, k))
+        })
+    }
+
+    /// Records `task` done in `seconds`.
+    fn finish(&mut self, task: Task, seconds: f64) {
+        self.done[task.tile] += 1;
+        self.finished += 1;
+        self.times.add(task.stage, seconds);
+        if task.stage == Stage::Accelerations {
+            let region = self.regions.iter().position(|r| r.contains(&task.tile)).unwrap_or(0);
+            self.dead[region].push_back(task.tile);
+        }
+    }
+}
+
+/// Runs every stage of every tile on the threads of the current rayon pool, each stage as
+/// one task once its inputs are done, as [`Board`] hands them out (on one thread in the
+/// order one thread runs them best). Returns the board with the threads' time in each kind.
+fn run_stages(board: Board, run: &(impl Fn(Task) + Sync)) -> Board {
+    let board = Mutex::new(board);
+    let lock = || board.lock().unwrap_or_else(PoisonError::into_inner);
+    let worker = |w: usize| {
+        lock().started += 1;
+        let mut finished = None;
+        loop {
+            let task = {
+                let mut b = lock();
+                if let Some((task, seconds)) = finished.take() {
+                    b.finish(task, seconds);
+                }
+                if b.failed || b.finished == b.stages() {
+                    return;
+                }
+                b.take(w)
+            };
+            let Some(task) = task else {
+                // A stage on another thread is under way (stages take tens of microseconds
+                // or more): wait for it without giving up the core.
+                for _ in 0..64 {
+                    std::hint::spin_loop();
+                }
+                continue;
+            };
+            let clock = Instant::now();
+            let failing = FailOnUnwind(&board);
+            run(task);
+            std::mem::forget(failing);
+            finished = Some((task, clock.elapsed().as_secs_f64()));
+        }
+    };
+    on_each_thread(0, board.lock().map_or(1, |b| b.regions.len()), &worker);
+    board.into_inner().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Runs `f(w)` for `w` in `first..threads` on threads of the current rayon pool (as many
+/// as take them up: with none free, the calling thread runs each in turn). Nothing `f`
+/// runs may wait for another call of `f` to start, and `f` must not fork rayon tasks
+/// itself: a thread waiting for a forked task may run another call of `f` on top of its own.
+fn on_each_thread(first: usize, threads: usize, f: &(impl Fn(usize) + Sync)) {
+    if first + 1 >= threads {
+        f(first);
+    } else {
+        rayon::join(|| f(first), || on_each_thread(first + 1, threads, f));
+    }
+}
+
+/// Marks the board failed if a stage unwinds, so that the other workers stop rather than
+/// wait for it.
+struct FailOnUnwind<'a>(&'a Mutex<Board>);
+
+impl Drop for FailOnUnwind<'_> {
+    fn drop(&mut self) {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).failed = true;
+    }
+}
+
+/// A slice that several threads write disjoint runs of at once, while other threads may
+/// read other elements through shared references to its owner.
+struct Tiled<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: elements are reached only through `run`, whose callers keep the threads' runs
+// apart.
+unsafe impl<T: Send> Send for Tiled<T> {}
+unsafe impl<T: Send> Sync for Tiled<T> {}
+
+impl<T> Tiled<T> {
+    fn new(v: &mut [T]) -> Self {
+        Self { ptr: v.as_mut_ptr(), len: v.len() }
+    }
+
+    /// The elements `r`, for this thread alone.
+    ///
+    /// # Safety
+    /// No other thread reads or writes them while the borrow lives, and the slice is alive
+    /// and not moved.
+    #[allow(clippy::mut_from_ref)]
+    unsafe fn run(&self, r: Range<usize>) -> &mut [T] {
+        assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
+        // SAFETY: in bounds (checked) and exclusive (the caller's contract).
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.len()) }
+    }
+}
+
+/// Rayon tasks of a stage: one, the whole tile (the workers of [`run_stages`] are the
+/// parallelism, and must not fork).
+const WHOLE_TILE: usize = usize::MAX;
+
 impl<const D: usize> FluidPasses<D> {
     /// The listing, summation density, pass A with the pressure update over `dt`, and pass B
     /// (whose shifting is scaled for `dt_accel`) of a step, tile by tile as `wave` plans
-    /// them ([`Wavefront::plan`] must have returned true for these particles).
+    /// them ([`Wavefront::plan`] must have returned true for these particles). The threads
+    /// of the pool each take whole stages of tiles whose inputs are done, so that a stage
+    /// forks nothing and threads wait for each other only where the dependencies make them.
     pub fn wavefront_step(
         &mut self,
         wave: &mut Wavefront,
@@ -386,59 +546,84 @@ impl<const D: usize> FluidPasses<D> {
         dt: f64,
         dt_accel: f64,
     ) -> StageTimes {
+        let clock = Instant::now();
         let StepBodies { fluid, cells, kernel, list, fluid_density, scheme, rates } = b;
         let n = fluid.len();
         list.begin(cells, n);
         fluid_density.resize(n, 0.0);
+        self.points.resize(n, Point::new(fluid.u[0], fluid.u_hat()[0], fluid.m[0], fluid.rho[0], fluid.p[0]));
         rates.a_c_dt = shifting_dt(scheme, dt_accel);
         let terms = RateTerms::new(scheme);
         let writes_ac = writes_homogenisation(scheme);
-        // A tile's payloads are dead once its pass B ran; their storage goes to the next tile
-        // listed. (IPST, after the step, reads only the pairs.)
-        let mut times = StageTimes::default();
-        wave.order_stages();
-        wave.dead.clear();
-        for &(stage, k) in &wave.schedule {
-            let clock = std::time::Instant::now();
-            let r = wave.range(k);
-            match stage {
-                Stage::List => {
-                    let chunks = r.start / CHUNK..r.end.div_ceil(CHUNK);
-                    if let Some(dead) = wave.dead.pop_front() {
-                        let from = wave.range(dead).start / CHUNK..wave.range(dead).end.div_ceil(CHUNK);
-                        for (d, c) in from.zip(chunks.clone()) {
-                            list.recycle(d, c);
+        let mut board = std::mem::take(&mut wave.board);
+        board.reset(&wave.bounds, rayon::current_num_threads());
+
+        // Each stage of a tile writes only that tile's elements, and reads its neighbours'
+        // only once their writers are done and before their next writer starts (the
+        // dependencies of `Board::ready`; see the match below). So the slices written are
+        // handed out by tile (`Tiled`, `ChunkWriter`), and read through shared references
+        // to their owners, at elements no thread is writing.
+        let (rho, p) = (Tiled::new(&mut fluid.rho), Tiled::new(&mut fluid.p));
+        let points = Tiled::new(&mut self.points);
+        let density = Tiled::new(fluid_density);
+        let (dp, du) = (Tiled::new(&mut rates.dp), Tiled::new(&mut rates.du));
+        let a_c = Tiled::new(if writes_ac { &mut rates.a_c[..] } else { &mut [] });
+        let writer = list.chunk_writer();
+        let (fluid, passes, list, tiles): (&Fluid<D>, &Self, &KernelList<D>, &Wavefront) =
+            (fluid, self, list, wave);
+        let views = FluidViews::of(fluid);
+        let listing = KernelAndDensity::new(fluid, kernel);
+        let chunks_of = |k: usize| tiles.range(k).start / CHUNK..tiles.range(k).end.div_ceil(CHUNK);
+        let run = |task: Task| {
+            let (k, r) = (task.tile, tiles.range(task.tile));
+            // SAFETY (of each `run`, `build_chunks` and `recycle` below): only this stage
+            // touches tile k's elements now. Every stage of a tile waits for the one before
+            // it on the tile. The list of tile k is read by passes A and B of tile k only,
+            // and a dead tile's by none: its pass B is done. The views of tile k's particles
+            // (`points`), written by its listing and its update, are read by the passes of
+            // tiles k - 1..=k + 1 (whose neighbours lie there, `Wavefront::plan`), which wait
+            // for those writes, and the update waits for the three passes A that read what
+            // it overwrites. Density, pressure and rates are read by tile k's stages only.
+            match task.stage {
+                Stage::List => unsafe {
+                    if let Some(dead) = task.dead {
+                        for (d, c) in chunks_of(dead).zip(chunks_of(k)) {
+                            writer.recycle(d, c);
                         }
                     }
-                    let rho = &mut fluid_density[r.clone()];
-                    build_kernel_chunks_summing_density(list, cells, fluid, kernel, chunks, rho);
+                    let rho_k = density.run(r.clone());
+                    let payload = |r2: &[f64], out: &mut [_]| listing.payload(r2, out);
+                    writer.build_chunks(list, cells, &fluid.x, payload, chunks_of(k), rho_k, |p| {
+                        listing.density(p)
+                    });
                     // Without walls the summation density is the fluid's share.
-                    let fd = &fluid_density[..];
-                    self.set_and_regather(fluid, r, |i, rho, _| *rho = fd[i]);
-                }
+                    let rho_k = &*rho_k;
+                    let own = (points.run(r.clone()), rho.run(r.clone()), p.run(r.clone()));
+                    set_and_regather(views, r.start, own, |i, rho, _| *rho = rho_k[i - r.start], WHOLE_TILE);
+                },
                 Stage::Rates => {
-                    let src = self.sources(fluid, list, None);
-                    pressure_rates(&terms, &src, r.start, &mut rates.dp[r]);
+                    let src = passes.sources(fluid, list, None);
+                    pressure_rates(&terms, &src, r.start, unsafe { dp.run(r.clone()) }, WHOLE_TILE);
                 }
-                Stage::Update => {
+                Stage::Update => unsafe {
                     // eq. (57)
-                    let dp = &rates.dp[..];
-                    self.set_and_regather(fluid, r, |i, _, p| *p += dt * dp[i]);
-                }
+                    let dp_k = &*dp.run(r.clone());
+                    let own = (points.run(r.clone()), rho.run(r.clone()), p.run(r.clone()));
+                    set_and_regather(views, r.start, own, |i, _, p| *p += dt * dp_k[i - r.start], WHOLE_TILE);
+                },
                 Stage::Accelerations => {
-                    let a_c = if writes_ac { &mut rates.a_c[r.clone()] } else { &mut [] };
-                    let du = &mut rates.du[r.clone()];
-                    self.write_accelerations(fluid, list, None, None, scheme, dt_accel, r.start, du, a_c);
-                    wave.dead.push_back(k);
+                    let a_c = if writes_ac { unsafe { a_c.run(r.clone()) } } else { &mut [] };
+                    let du = unsafe { du.run(r.clone()) };
+                    passes.write_accelerations(
+                        fluid, list, None, None, scheme, dt_accel, r.start, du, a_c, WHOLE_TILE,
+                    );
                 }
             }
-            let t = clock.elapsed().as_secs_f64();
-            match stage {
-                Stage::List => times.list += t,
-                Stage::Rates | Stage::Update => times.pressure += t,
-                Stage::Accelerations => times.accelerations += t,
-            }
-        }
+        };
+        let board = run_stages(board, &run);
+        debug_assert!(!board.failed && board.finished == board.stages(), "every stage ran");
+        let times = board.times.scaled(clock.elapsed().as_secs_f64());
+        wave.board = board;
         times
     }
 }
@@ -452,30 +637,90 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     /// Every stage of every tile runs once, after the stage before it on the tile and on
-    /// both tiles next to it (cyclically); and the list stays local: at most seven tiles
-    /// are listed and not yet through pass B at any time (four in the wave, three held
-    /// back at the periodic edge), whatever the number of tiles.
+    /// both tiles next to it (cyclically), as the board hands the stages to workers that
+    /// take turns (one, two or three, starting at once or one late, each stage taking one
+    /// turn). One worker keeps the list local: at most seven tiles are listed and not yet
+    /// through pass B at any time (four in the wave, three held back at the periodic edge),
+    /// whatever the number of tiles. Several workers each run a wave over their region, and
+    /// wait for each other no longer on many tiles than on few.
     #[test]
-    fn the_schedule_runs_each_stage_once_after_its_inputs() {
-        for n in 1..60 {
-            let mut w = Wavefront::with_limits(1, 1);
-            w.bounds = (0..=n).collect();
-            w.order_stages();
-            let mut level = vec![0; n];
-            let mut most_open = 0;
-            for &(stage, k) in &w.schedule {
-                let s = STAGES.iter().position(|&t| t == stage).unwrap();
-                assert_eq!(level[k], s, "{n} tiles: {stage:?} on tile {k}");
-                if s > 0 {
-                    for b in [(k + 1) % n, (k + n - 1) % n] {
-                        assert!(level[b] >= s, "{n} tiles: {stage:?} on tile {k} before its inputs on {b}");
+    fn the_board_runs_each_stage_once_after_its_inputs() {
+        let mut idle_turns = Vec::new();
+        for workers in 1..=3 {
+            for late in [false, true] {
+                for n in 1..60 {
+                    let what =
+                        format!("{n} tiles, {workers} workers{}", if late { ", one late" } else { "" });
+                    let bounds: Vec<usize> = (0..=n).map(|k| k * 100).collect();
+                    let mut b = Board::default();
+                    b.reset(&bounds, workers);
+                    let mut running: Vec<Option<Task>> = vec![None; workers];
+                    let (mut most_open, mut turns, mut idle) = (0, 0, 0);
+                    b.started = if late { workers - 1 } else { workers };
+                    while b.finished < b.stages() {
+                        turns += 1;
+                        assert!(turns < 10 * b.stages(), "{what}: stuck");
+                        for (w, running) in running.iter_mut().enumerate() {
+                            if late && w == workers - 1 && turns < 5 {
+                                continue;
+                            }
+                            if late && w == workers - 1 && turns == 5 {
+                                b.started += 1;
+                            }
+                            if let Some(t) = running.take() {
+                                b.finish(t, 1.0);
+                            }
+                            if let Some(t) = b.take(w) {
+                                let (s, k) = (t.stage as usize, t.tile);
+                                assert_eq!(b.taken[k] as usize, s + 1, "{what}: {t:?}");
+                                assert_eq!(b.done[k] as usize, s, "{what}: {t:?} before the stage before it");
+                                for j in [(k + 1) % n, (k + n - 1) % n] {
+                                    assert!(
+                                        b.done[j] as usize >= s,
+                                        "{what}: {t:?} before its inputs on {j}"
+                                    );
+                                }
+                                *running = Some(t);
+                            } else if !late || turns > 5 {
+                                idle += 1;
+                            }
+                        }
+                        let open = b.done.iter().filter(|&&l| (1..4).contains(&l)).count();
+                        most_open = most_open.max(open);
+                        if b.finished + running.iter().flatten().count() == b.stages() {
+                            for t in running.iter_mut().filter_map(Option::take) {
+                                b.finish(t, 1.0);
+                            }
+                        }
                     }
+                    assert!(
+                        b.done.iter().all(|&l| l == 4) && b.taken.iter().all(|&l| l == 4),
+                        "{what}: every stage once"
+                    );
+                    if workers == 1 {
+                        assert!(most_open <= 7, "{what}: {most_open} tiles open at once");
+                    }
+                    let covered: usize = b.regions.iter().map(|r| r.len()).sum();
+                    assert_eq!(covered, n, "{what}: the regions cover the tiles");
+                    idle_turns.push((workers, late, n, idle));
                 }
-                level[k] += 1;
-                most_open = most_open.max(level.iter().filter(|&&l| (1..4).contains(&l)).count());
             }
-            assert!(level.iter().all(|&l| l == 4), "{n} tiles: every stage once");
-            assert!(most_open <= 7, "{n} tiles: {most_open} tiles open at once");
+        }
+        // The waves never stall on each other: the turns a worker waits (for a region one
+        // tile longer than another, or a late start) do not grow with the number of tiles.
+        for workers in 1..=3 {
+            for late in [false, true] {
+                let most = |tiles: Range<usize>| {
+                    let of =
+                        idle_turns.iter().filter(|t| t.0 == workers && t.1 == late && tiles.contains(&t.2));
+                    of.map(|t| t.3).max().unwrap()
+                };
+                let (few, many) = (most(16..22), most(22..60));
+                assert!(
+                    many <= few,
+                    "{workers} workers, late {late}: waits {many} turns on many tiles, {few} on 16-21"
+                );
+            }
         }
     }
 
@@ -497,8 +742,8 @@ mod tests {
                 cells.mark_reordered();
                 let mut list = NeighbourList::<2>::new();
                 list.build(&cells, &x, |_, _| {});
-                let mut w = Wavefront::with_limits(1, 4);
-                if !w.plan(&cells, n, Tiles::Narrow) {
+                let mut w = Wavefront::new();
+                if !w.plan(&cells, n) {
                     continue;
                 }
                 planned += 1;
@@ -535,14 +780,14 @@ mod tests {
     /// Without candidates it runs the sweeps and keeps nothing.
     #[test]
     fn the_tuner_keeps_the_schedule_with_the_shortest_median_settled_step() {
-        let (wide, narrow) = (Schedule::Wavefront(Tiles::Wide), Schedule::Wavefront(Tiles::Narrow));
-        let tune = |narrow_settled: f64| {
+        let tiles = Schedule::Wavefront;
+        let tune = |tiles_settled: f64| {
             let mut t = Tuner::default();
             assert!(t.needs_candidates());
             assert_eq!(t.next(), Schedule::Sweeps);
             t.record(Schedule::Sweeps, 1.0);
             assert_eq!(t.chosen(), None, "nothing timed without candidates");
-            t.offer(vec![Schedule::Sweeps, wide, narrow]);
+            t.offer(vec![Schedule::Sweeps, tiles]);
             assert!(!t.needs_candidates());
             let (mut order, mut at) = (Vec::new(), 0);
             while t.chosen().is_none() {
@@ -554,11 +799,10 @@ mod tests {
                     _ if at < BLOCK => 5.0, // the run's first steps
                     Schedule::Sweeps if settled => 1.0,
                     Schedule::Sweeps => 3.0,
-                    _ if s == wide => 1.2,
                     _ if !settled => 0.1,
-                    // one slow step among the narrow tiles' settled ones
-                    _ if order.iter().filter(|&&o| o == narrow).count() == BLOCK - 1 => 9.0,
-                    _ => narrow_settled,
+                    // one slow step, the tiles' first settled one
+                    _ if order.iter().filter(|&&o| o == tiles).count() == SETTLE => 9.0,
+                    _ => tiles_settled,
                 };
                 t.record(s, seconds);
                 order.push(s);
@@ -566,7 +810,7 @@ mod tests {
             }
             let mut expected = vec![Schedule::Sweeps; BLOCK];
             for _ in 0..ROUNDS {
-                for s in [Schedule::Sweeps, wide, narrow] {
+                for s in [Schedule::Sweeps, tiles] {
                     expected.extend([s; BLOCK]);
                 }
             }
@@ -574,21 +818,21 @@ mod tests {
             assert_eq!(order.len(), TUNING_STEPS);
             t
         };
-        let mut t = tune(1.4);
-        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "the narrow tiles' fast first steps do not decide");
+        let mut t = tune(1.1);
+        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "the tiles' fast first steps do not decide");
         let t2 = tune(0.9);
-        assert_eq!(t2.chosen(), Some(narrow), "one slow step does not decide");
-        assert_eq!(t2.next(), narrow);
-        t.record(narrow, 0.01);
-        t.offer(vec![narrow]);
+        assert_eq!(t2.chosen(), Some(tiles), "one slow step does not decide");
+        assert_eq!(t2.next(), tiles);
+        t.record(tiles, 0.01);
+        t.offer(vec![tiles]);
         assert_eq!(t.chosen(), Some(Schedule::Sweeps), "kept once chosen");
         let mut slow = Tuner::default();
-        slow.offer(vec![Schedule::Sweeps, wide]);
+        slow.offer(vec![Schedule::Sweeps, tiles]);
         while slow.chosen().is_none() {
-            slow.record(narrow, 0.1);
+            slow.record(Schedule::Tuned, 0.1);
             let s = slow.next();
-            slow.record(s, if s == wide { 1.2 } else { 1.0 });
+            slow.record(s, if s == tiles { 1.2 } else { 1.0 });
         }
-        assert_eq!(slow.chosen(), Some(Schedule::Sweeps), "only candidates count");
+        assert_eq!(slow.chosen(), Some(Schedule::Sweeps), "only the schedule run counts");
     }
 }
