@@ -49,11 +49,12 @@ use std::ops::Range;
 use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
-/// The fewest tiles a wavefront step is run with: a wave needs a few tiles to run in (two
-/// threads' waves, a few each), and a body that makes fewer has a list the cache holds.
-/// From nx = 100 in 2D (six tiles); whether the wavefront pays there is the tuner's to
-/// find (`ctvf`+`ipst` ran 5-8 % faster in it on one thread on the host of session 39).
-const MIN_TILES: usize = 4;
+/// The fewest tiles a wavefront step is run with (from nx = 130 or so in 2D). On the host
+/// of session 39, `ctvf`+`ipst` at nx = 150 (ten tiles) ran 6-8 % faster in tiles than in
+/// sweeps on one thread; at nx = 100 (six tiles), whose list the cache mostly holds, the
+/// two took the same time in three rounds, so offering the tiles there only gave the tuner
+/// a choice to get wrong.
+const MIN_TILES: usize = 8;
 
 /// A stage of a tile, in the order they run on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -72,8 +73,10 @@ enum Stage {
 const STAGES: [Stage; 4] = [Stage::List, Stage::Rates, Stage::Update, Stage::Accelerations];
 
 /// The tiles of a body and the order their stages run in.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug)]
 pub struct Wavefront {
+    /// The fewest tiles a wavefront step is run with.
+    min_tiles: usize,
     /// Tile `k` holds the particles `bounds[k]..bounds[k + 1]`.
     bounds: Vec<usize>,
     /// The start of every non-empty cell layer, then the number of particles.
@@ -94,16 +97,28 @@ pub fn applies(scheme: &FluidScheme, walls: bool) -> bool {
         && scheme.pressure_reference != PressureReference::GlobalMean
 }
 
+impl Default for Wavefront {
+    fn default() -> Self {
+        Self::with_min_tiles(MIN_TILES)
+    }
+}
+
 impl Wavefront {
     /// No tiles.
     pub fn new() -> Self {
         Self::default()
     }
 
+    /// No tiles; at least `min_tiles` of them to come for a wavefront step (tests cut
+    /// small bodies into few tiles).
+    pub(crate) fn with_min_tiles(min_tiles: usize) -> Self {
+        Self { min_tiles, bounds: Vec::new(), layers: Vec::new(), board: Board::default() }
+    }
+
     /// Cuts the `n` particles binned by `cells` (in cell order) into tiles of whole list
     /// chunks, each at least two cell layers and a chunk wide, and checks that every
     /// particle's neighbours lie in its tile or the next ones (cyclically). Returns whether
-    /// the body makes at least `MIN_TILES` (4) such tiles.
+    /// the body makes at least `MIN_TILES` (8) such tiles.
     pub fn plan<const D: usize>(&mut self, cells: &CellList<D>, n: usize) -> bool {
         self.layers.clear();
         for l in 0..cells.layers() {
@@ -120,7 +135,7 @@ impl Wavefront {
         let widest_pair = self.layers.windows(3).map(|w| w[2] - w[0]).max().unwrap_or(n);
         let width = (widest_pair.div_ceil(CHUNK) + 1) * CHUNK;
         let tiles = n / width;
-        if tiles < MIN_TILES {
+        if tiles < self.min_tiles.max(1) {
             return false;
         }
         self.bounds.clear();
@@ -742,7 +757,7 @@ mod tests {
                 cells.mark_reordered();
                 let mut list = NeighbourList::<2>::new();
                 list.build(&cells, &x, |_, _| {});
-                let mut w = Wavefront::new();
+                let mut w = Wavefront::with_min_tiles(4);
                 if !w.plan(&cells, n) {
                     continue;
                 }
