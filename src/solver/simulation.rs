@@ -739,6 +739,31 @@ mod tests {
         }
     }
 
+    /// A body of four tiles (64 x 64), the fewest a wave runs in, on two threads: two
+    /// regions of two tiles, each region's first passes waiting on the other's last
+    /// listing. One step equals the sweeps' bit for bit.
+    #[test]
+    fn four_tiles_on_two_threads_step_as_the_sweeps() {
+        let run = |schedule: Schedule| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+            pool.install(|| {
+                let mut sim = vortex_sized(64, SchemeName::Edac, Pst::None, RatePositions::End);
+                sim.wave = Wavefront::with_min_tiles(4);
+                sim.set_schedule(schedule);
+                sim.step(f64::INFINITY).unwrap();
+                assert_eq!(sim.wavefront_steps, u64::from(schedule == Schedule::Wavefront));
+                if schedule == Schedule::Wavefront {
+                    assert_eq!(sim.wave.tiles(), 4);
+                }
+                let (f, r) = (&sim.state.fluid, &sim.state.rates);
+                let mut bits: Vec<u64> = f.p.iter().chain(&f.rho).map(|x| x.to_bits()).collect();
+                bits.extend(r.du.iter().chain(&f.u).flat_map(|v| v.iter().map(|c| c.to_bits())));
+                bits
+            })
+        };
+        assert_eq!(run(Schedule::Wavefront), run(Schedule::Sweeps));
+    }
+
     /// The wavefront step sums what the sweeps sum, in the same order: the same state, bit
     /// for bit, for `edac`, `ctvf`+`sun` and `ctvf`+`ipst`, on one, two and three threads
     /// (each its wave over a region of the tiles), and when the tuner changes the order

@@ -616,7 +616,10 @@ impl<const D: usize, P: Copy + Default + Send + Sync> ChunkWriter<D, P> {
         out: &mut [R],
         reduce: impl Fn(Listed<'_, P>) -> R + Sync,
     ) {
-        assert!(std::ptr::eq(list.chunks.as_ptr(), self.chunks), "the writer's own list");
+        assert!(
+            std::ptr::eq(list.chunks.as_ptr(), self.chunks) && list.chunks.len() == self.len,
+            "the writer's own list, not resized"
+        );
         // SAFETY: the caller's contract.
         let into =
             ChunkRun { chunks: unsafe { self.run(chunks.clone()) }, first: chunks.start, split: usize::MAX };
