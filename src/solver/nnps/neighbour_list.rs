@@ -123,7 +123,7 @@ impl<const D: usize, P: Copy + Default> Chunk<D, P> {
     }
 
     /// Hands this chunk's payload storage to `next` and takes `next`'s
-    /// ([`NeighbourList::recycle`]).
+    /// ([`ChunkWriter::recycle`]).
     fn hand_payload_to(&mut self, next: &mut Self) {
         std::mem::swap(&mut self.payload, &mut next.payload);
         self.payload_stale = true;
@@ -233,47 +233,19 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     ) {
         assert_eq!(out.len(), points.len(), "one reduction per point");
         let chunks = self.begin(cells, points.len());
-        self.build_chunks(cells, points, payload, chunks, out, reduce);
+        let into = ChunkRun { chunks: &mut self.chunks[chunks], first: 0, split: 1 };
+        list_chunks(into, &self.shifts, self.sources, cells, points, payload, out, reduce);
     }
 
     /// Readies the list for a build over `n` points in [`CHUNK`]s: returns the chunks,
-    /// which [`build_chunks`](Self::build_chunks) then lists, in any number of calls. Until
-    /// every chunk is built, only the points of built chunks may be queried.
+    /// which a [`ChunkWriter`] then lists, in any number of calls. Until every chunk is
+    /// built, only the points of built chunks may be queried.
     pub fn begin(&mut self, cells: &CellList<D>, n: usize) -> std::ops::Range<usize> {
         assert!(n < (1 << J_BITS), "neighbour lists hold at most 2^{J_BITS} points");
         self.set_shifts(cells);
         self.sources = n;
         self.chunks.resize_with(n.div_ceil(CHUNK), Chunk::default);
         0..self.chunks.len()
-    }
-
-    /// Hands the payload storage of chunk `dead`, whose payloads will not be read again
-    /// before the next build, to chunk `next`, about to be built (and `next`'s to `dead`):
-    /// the payloads, most of a list's bytes, are then written into memory just read, still
-    /// in cache, rather than into memory last touched a build ago. `dead` keeps its pairs
-    /// ([`half_pairs`](Self::half_pairs) still reads them); a query of its payloads panics.
-    pub fn recycle(&mut self, dead: usize, next: usize) {
-        assert_ne!(dead, next, "two chunks");
-        let (lo, hi) = self.chunks.split_at_mut(dead.max(next));
-        let (low, high) = (&mut lo[dead.min(next)], &mut hi[0]);
-        let (dead, next) = if dead < next { (low, high) } else { (high, low) };
-        dead.hand_payload_to(next);
-    }
-
-    /// Lists the points of `chunks` (after [`begin`](Self::begin)), as
-    /// [`build_reducing`](Self::build_reducing) lists all: `out` holds one reduction per
-    /// point of these chunks, from the first chunk's first point.
-    pub fn build_chunks<R: Send>(
-        &mut self,
-        cells: &CellList<D>,
-        points: &[Vector<D>],
-        payload: impl Fn(&[f64], &mut [P]) + Sync,
-        chunks: std::ops::Range<usize>,
-        out: &mut [R],
-        reduce: impl Fn(Listed<'_, P>) -> R + Sync,
-    ) {
-        let into = ChunkRun { chunks: &mut self.chunks[chunks.clone()], first: chunks.start, split: 1 };
-        list_chunks(into, &self.shifts, self.sources, cells, points, payload, out, reduce);
     }
 
     /// After [`begin`](Self::begin): a writer through which several threads list disjoint
@@ -502,7 +474,7 @@ struct ChunkRun<'a, const D: usize, P> {
 }
 
 /// Lists the points of the chunks of `into` among `points`, as
-/// [`NeighbourList::build_chunks`] does (`shifts` and `sources` are the list's).
+/// [`NeighbourList::build_reducing`] lists all (`shifts` and `sources` are the list's).
 #[allow(clippy::too_many_arguments)]
 fn list_chunks<const D: usize, P: Copy + Default + Send + Sync, R: Send>(
     into: ChunkRun<'_, D, P>,
@@ -598,8 +570,10 @@ impl<const D: usize, P: Copy + Default + Send + Sync> ChunkWriter<D, P> {
         unsafe { std::slice::from_raw_parts_mut(self.chunks.add(run.start), run.len()) }
     }
 
-    /// As [`NeighbourList::build_chunks`] on `list`, the list this writer was made from,
-    /// in one task on the calling thread.
+    /// Lists the points of `chunks` of `list`, the list this writer was made from, as
+    /// [`NeighbourList::build_reducing`] lists all, in one task on the calling thread:
+    /// `out` holds one reduction per point of these chunks, from the first chunk's first
+    /// point.
     ///
     /// # Safety
     /// While it runs, no other thread reads or writes the chunks `chunks` (their points'
@@ -626,7 +600,11 @@ impl<const D: usize, P: Copy + Default + Send + Sync> ChunkWriter<D, P> {
         list_chunks(into, &list.shifts, list.sources, cells, points, payload, out, reduce);
     }
 
-    /// As [`NeighbourList::recycle`].
+    /// Hands the payload storage of chunk `dead`, whose payloads will not be read again
+    /// before the next build, to chunk `next`, about to be built (and `next`'s to `dead`):
+    /// the payloads, most of a list's bytes, are then written into memory just read, still
+    /// in cache, rather than into memory last touched a build ago. `dead` keeps its pairs
+    /// ([`NeighbourList::half_pairs`] still reads them); a query of its payloads panics.
     ///
     /// # Safety
     /// While it runs, no other thread reads or writes chunks `dead` or `next`.

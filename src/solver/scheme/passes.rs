@@ -70,9 +70,8 @@ pub fn build_kernel_list_summing_density<const D: usize>(
     rho: &mut Vec<f64>,
 ) {
     rho.resize(fluid.len(), 0.0);
-    let chunks = nl.begin(cells, fluid.len());
     let list = KernelAndDensity::new(fluid, k);
-    nl.build_chunks(cells, &fluid.x, |r2, out| list.payload(r2, out), chunks, rho, |p| list.density(p));
+    nl.build_reducing(cells, &fluid.x, |r2, out| list.payload(r2, out), rho, |p| list.density(p));
 }
 
 /// What a fluid's list build computes for each pair, its [`PairKernel`] from the pair's
