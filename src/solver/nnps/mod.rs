@@ -20,7 +20,7 @@ pub use cell_list::CellList;
 /// The implementations of the list build's distance test (same bits; the fastest is used).
 pub use filter::Path as DistanceTest;
 pub use neighbour_list::{ChunkWriter, HalfPairs, Listed, NeighbourList, PairSlices, CHUNK};
-pub use slabs::{PerPoint, Slabs};
+pub use slabs::Slabs;
 
 use crate::solver::math::Vector;
 

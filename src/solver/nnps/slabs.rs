@@ -4,10 +4,10 @@
 //!
 //! With the points in cell order, the neighbours `j > i` of a point `i` lie in its own layer
 //! or the next one (a cell is at least a search radius wide), or, across a periodic last
-//! axis, in the last layer when `i` is in the first. A loop over the pairs `j > i` of every
-//! slab, the slabs in parallel, adds the shares of the points of its own slab at once and
-//! sets the others aside ("spills"); a second parallel loop adds each slab's spills in a
-//! fixed order. Every sum then runs in an order fixed by the partition, which depends on the
+//! axis, in the last layer when `i` is in the first. A loop over the pairs `j > i` of a slab
+//! adds the shares of the points of its own slab at once and sets the others aside
+//! ("spills"), which the slabs that receive them add in a fixed order once that loop is
+//! done (IPST's sweeps run the slabs as stages on the threads of the pool). Every sum then runs in an order fixed by the partition, which depends on the
 //! geometry alone: the result does not depend on the number of threads, and no two threads
 //! write the same point.
 
@@ -75,69 +75,10 @@ impl Slabs {
         previous.into_iter().chain(first)
     }
 
-    /// Calls `f(s, data_s, state_s)` for every slab `s` in parallel, with `data_s` the
-    /// slab's part of `data` (one element per point, from the slab's first point; a pair of
-    /// such slices is split alike) and `state[s]`. Allocates nothing.
-    pub fn for_each_mut<T: PerPoint, S: Send, F>(&self, data: T, state: &mut [S], f: &F)
-    where
-        F: Fn(usize, T, &mut S) + Sync,
-    {
-        assert_eq!(data.points(), *self.bounds.last().unwrap_or(&0), "one element per point");
-        assert_eq!(state.len(), self.len(), "one state per slab");
-        if !self.is_empty() {
-            split(&self.bounds, 0, data, state, f);
-        }
+    /// The slabs' first points, then the number of points.
+    pub fn bounds(&self) -> &[usize] {
+        &self.bounds
     }
-}
-
-/// Data with one element per point that a loop over slabs hands out in parts: a mutable
-/// slice, or a pair of them.
-pub trait PerPoint: Send + Sized {
-    /// Number of points.
-    fn points(&self) -> usize;
-    /// The first `k` points' part and the rest.
-    fn split_at(self, k: usize) -> (Self, Self);
-}
-
-impl<T: Send> PerPoint for &mut [T] {
-    fn points(&self) -> usize {
-        self.len()
-    }
-
-    fn split_at(self, k: usize) -> (Self, Self) {
-        self.split_at_mut(k)
-    }
-}
-
-impl<A: PerPoint, B: PerPoint> PerPoint for (A, B) {
-    fn points(&self) -> usize {
-        debug_assert_eq!(self.0.points(), self.1.points());
-        self.0.points()
-    }
-
-    fn split_at(self, k: usize) -> (Self, Self) {
-        let ((a0, a1), (b0, b1)) = (self.0.split_at(k), self.1.split_at(k));
-        ((a0, b0), (a1, b1))
-    }
-}
-
-/// Halves the slabs `bounds` (the first numbered `first`) until one is left, in parallel.
-fn split<T: PerPoint, S: Send, F>(bounds: &[usize], first: usize, data: T, state: &mut [S], f: &F)
-where
-    F: Fn(usize, T, &mut S) + Sync,
-{
-    let n = bounds.len() - 1;
-    if n == 1 {
-        f(first, data, &mut state[0]);
-        return;
-    }
-    let mid = n / 2;
-    let (dl, dr) = data.split_at(bounds[mid] - bounds[0]);
-    let (sl, sr) = state.split_at_mut(mid);
-    rayon::join(
-        || split(&bounds[..=mid], first, dl, sl, f),
-        || split(&bounds[mid..], first + mid, dr, sr, f),
-    );
 }
 
 #[cfg(test)]
@@ -215,34 +156,6 @@ mod tests {
                     }
                 });
             }
-        }
-    }
-
-    #[test]
-    fn each_slab_gets_its_own_part_of_the_data() {
-        let (cells, x) = sorted_lattice(30, 0.1);
-        let mut slabs = Slabs::new();
-        slabs.partition(&cells, 100, 1);
-        let mut data = vec![usize::MAX; x.len()];
-        let mut state = vec![0usize; slabs.len()];
-        slabs.for_each_mut(&mut data[..], &mut state, &|s, d: &mut [usize], n| {
-            d.iter_mut().for_each(|v| *v = s);
-            *n = d.len();
-        });
-        for s in 0..slabs.len() {
-            assert!(data[slabs.range(s)].iter().all(|&v| v == s));
-            assert_eq!(state[s], slabs.range(s).len());
-        }
-        // A pair of slices is split alike.
-        let mut other = vec![0.0; x.len()];
-        slabs.for_each_mut((&mut data[..], &mut other[..]), &mut state, &|s, (d, o), n| {
-            assert_eq!(d.len(), o.len());
-            assert!(d.iter().all(|&v| v == s), "slab {s} got another slab's part");
-            o.iter_mut().for_each(|v| *v = s as f64);
-            *n = o.len();
-        });
-        for s in 0..slabs.len() {
-            assert!(other[slabs.range(s)].iter().all(|&v| v == s as f64));
         }
     }
 }

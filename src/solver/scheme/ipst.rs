@@ -4,8 +4,15 @@
 //! acceleration. Unlike the gather passes of [`passes`](super::passes), each sweep
 //! evaluates every fluid pair once and adds it to both particles, in slabs fixed by the
 //! geometry ([`Slabs`]), so that its sums, too, do not depend on the thread count.
+//!
+//! The sweeps and moves of all the iterations run as stages of the slabs on the threads of
+//! the pool ([`stages`](super::stages)), a slab's next sweep starting once the slabs around
+//! it have moved, rather than as two parallel loops a sweep: at nx = 100 on two threads
+//! each loop lost some 20 microseconds to its join, and the moves took 1.5x their one-thread
+//! time, about a tenth of IPST's time in all (docs/throughput.md, session 40).
 
 use super::passes::{FluidPasses, KernelList, PairKernel, MIN_LEN};
+use super::stages::{run_stages, Board, Grid, Tiled};
 use super::{FluidScheme, Shifting, SurfaceFields, WallSet};
 use crate::solver::equations::{free_surface, shifting};
 use crate::solver::kernel::{Kernel, ScaledKernel};
@@ -14,23 +21,24 @@ use crate::solver::nnps::{CellList, HalfPairs, PairSlices, Slabs};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
+use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
 
 /// IPST's work space, kept from step to step (it grows on first use, in scenes that
 /// declare IPST only).
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub(super) struct IpstWork<const D: usize> {
-    /// The moved positions of the current sweep, and of the next.
-    x_shift: Vec<Vector<D>>,
-    x_next: Vec<Vector<D>>,
+    /// The moved positions: sweep m reads `x[m % 2]` and moves them into the other.
+    x: [Vec<Vector<D>>; 2],
     slabs: Slabs,
-    slab_work: Vec<IpstSlab<D>>,
+    slab_work: Vec<Mutex<IpstSlab<D>>>,
     /// Each particle's sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
     sums: Vec<(Vector<D>, f64)>,
-    /// Each slab's largest chi in the last sweep.
-    slab_chi_max: Vec<f64>,
     /// The fluid's and the walls' volumes, as compact arrays.
     vol: Vec<f64>,
     wall_vol: Vec<f64>,
+    /// Which sweeps and moves are done on each slab.
+    board: SweepBoard,
 }
 
 impl<const D: usize> FluidPasses<D> {
@@ -76,9 +84,10 @@ impl<const D: usize> FluidPasses<D> {
         }
         let k = k.scaled(fluid.h);
         let n = fluid.len();
-        w.x_shift.clear();
-        w.x_shift.extend_from_slice(&fluid.x);
-        w.x_next.resize(n, Vector::zeros());
+        let [x0, x1] = &mut w.x;
+        x0.clear();
+        x0.extend_from_slice(&fluid.x);
+        x1.resize(n, Vector::zeros());
         w.sums.resize(n, (Vector::zeros(), 0.0));
         // The volumes gathered by `accelerations` at these positions, as compact arrays
         // (the sweeps read nothing else of the neighbours).
@@ -88,65 +97,217 @@ impl<const D: usize> FluidPasses<D> {
         w.wall_vol.clear();
         w.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
         w.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
-        w.slab_work.resize_with(w.slabs.len(), IpstSlab::default);
-        w.slab_chi_max.resize(w.slabs.len(), f64::MIN);
+        w.slab_work.resize_with(w.slabs.len(), Default::default);
         let (vol, wall_vol, slabs) = (&w.vol, &w.wall_vol, &w.slabs);
-        w.slab_work
-            .par_iter_mut()
-            .enumerate()
-            .for_each(|(t, slab)| nl.half_pairs(slabs.range(t), &mut slab.half));
+        w.slab_work.par_iter_mut().enumerate().for_each(|(t, slab)| {
+            let slab = slab.get_mut().unwrap_or_else(PoisonError::into_inner);
+            nl.half_pairs(slabs.range(t), &mut slab.half);
+        });
         // A particle's own share of chi (its pair with itself is not in the half list).
         let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
         let walls = walls.map(|ws| (ws, &wall_vol[..]));
-        let mut iterations = 0;
-        while iterations < max_iter {
-            // One sweep: the sums of eqs. (37) and (40) at the current positions, each slab's
-            // pairs in parallel (the shares of other slabs' particles set aside); then, slab by
-            // slab in parallel, the shares set aside, chi and the moved positions (eq. 37) into
-            // a second buffer, used if chi has not converged.
-            let xs: &[Vector<D>] = &w.x_shift;
-            slabs.for_each_mut(&mut w.sums[..], &mut w.slab_work, &|t, sums, slab| {
-                slab.sweep(slabs.range(t), sums, xs, nl, vol, walls, &k, chi_self);
-            });
-            let done = &w.slab_work;
-            let data = (&mut w.sums[..], &mut w.x_next[..]);
-            slabs.for_each_mut(data, &mut w.slab_chi_max, &|t, (sums, next), chi_max| {
-                let range = slabs.range(t);
+        let test = Convergence { chi_ref, tol };
+        let mut board = std::mem::take(&mut w.board);
+        board.reset(slabs.bounds(), rayon::current_num_threads().min(slabs.len()), max_iter, test);
+
+        // Sweep m reads the positions x[m % 2] and writes each slab's sums and spills; the
+        // move m writes x[(m + 1) % 2]. A slab's stages run one after another, so its sums
+        // are its own stages' alone. The stages wait for each other as `SweepBoard` says, so
+        // that each buffer is read and written at no element at once:
+        // - sweep m of slab t reads x[m % 2] at t and its neighbours j > i (in t + 1, and in
+        //   the last slab for the first), after the moves m - 1 of t - 1..=t + 1 and before
+        //   any move m + 1, which waits for the test of sweep m, itself after every move m,
+        //   and each move m after the sweeps m of its slab and both next to it;
+        // - move m of slab t overwrites x^{m-1} there, which the sweeps m - 1 of t - 1 and t
+        //   (and of the first slab, if t is the last) read: it waits for the sweeps m of
+        //   t - 1..=t + 1, which waited for the moves m - 1 around them, which waited for the
+        //   sweeps m - 1 around those.
+        // The spills are behind a mutex each, uncontended: a slab's spills are read by the
+        // moves of the slabs next to it before its next sweep, which waits for them.
+        let x = [Tiled::new(x0), Tiled::new(x1)];
+        let sums = Tiled::new(&mut w.sums);
+        let slab_work = &w.slab_work;
+        let lock = |t: usize| slab_work[t].lock().unwrap_or_else(PoisonError::into_inner);
+        let run = |task: SweepTask| -> f64 {
+            let (m, t) = (task.sweep as usize, task.slab);
+            let range = slabs.range(t);
+            // SAFETY: see above: only this stage touches slab t's sums now, and no stage
+            // writes the positions it reads, nor reads those it writes.
+            let sums = unsafe { sums.run(range.clone()) };
+            if !task.moves {
+                let xs = unsafe { x[m % 2].view() };
+                lock(t).sweep(range, sums, xs, nl, vol, walls, &k, chi_self);
+                f64::MIN
+            } else {
                 for source in slabs.spill_sources(t) {
-                    for &(j, d, chi) in &done[source].spill {
-                        if let Some(sum) = (j as usize).checked_sub(range.start).and_then(|l| sums.get_mut(l))
-                        {
-                            sum.0 += d;
-                            sum.1 += chi;
-                        }
-                    }
+                    add_spill(&lock(source).spill, range.start, sums);
                 }
-                *chi_max = f64::MIN;
-                for ((i, &(d, chi)), next) in range.zip(sums.iter()).zip(next) {
-                    let mut dr = d * (u_max * dt);
-                    if let Some(fs) = surface {
-                        // eq. (45)
-                        dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
-                    }
-                    // Not wrapped: the list's image shifts refer to the unwrapped positions.
-                    *next = xs[i] + dr;
-                    *chi_max = chi_max.max(chi);
-                }
-            });
-            // The largest chi (max is exact: any grouping gives the same).
-            let chi_max = w.slab_chi_max.iter().fold(f64::MIN, |m, &c| m.max(c));
-            if (chi_max - chi_ref).abs() <= tol * chi_ref {
-                break;
+                let from = unsafe { &x[m % 2].view()[range.clone()] };
+                let to = unsafe { x[(m + 1) % 2].run(range.clone()) };
+                move_slab(range, sums, from, to, surface, u_max * dt)
             }
-            std::mem::swap(&mut w.x_shift, &mut w.x_next);
-            iterations += 1;
-        }
+        };
+        let board = run_stages(board, &run);
+        let iterations = board.iterations();
+        w.board = board;
         let f = 2.0 / (dt * dt);
-        let (x0, xs) = (&fluid.x, &w.x_shift);
+        let (x0, xs) = (&fluid.x, &w.x[iterations % 2]);
         rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
             *ac = (xs[i] - x0[i]) * f;
         });
         iterations
+    }
+}
+
+/// Adds the shares `spill` set aside for particles from `first` on to their sums `sums`.
+fn add_spill<const D: usize>(spill: &[(u32, Vector<D>, f64)], first: usize, sums: &mut [(Vector<D>, f64)]) {
+    for &(j, d, chi) in spill {
+        if let Some(sum) = (j as usize).checked_sub(first).and_then(|l| sums.get_mut(l)) {
+            sum.0 += d;
+            sum.1 += chi;
+        }
+    }
+}
+
+/// Moves the particles `range` from `xs` to `next` by `scale` times their sums (eq. 37),
+/// adjusted at a free surface (eq. 45); returns their largest chi.
+fn move_slab<const D: usize>(
+    range: Range<usize>,
+    sums: &[(Vector<D>, f64)],
+    xs: &[Vector<D>],
+    next: &mut [Vector<D>],
+    surface: Option<&SurfaceFields<D>>,
+    scale: f64,
+) -> f64 {
+    let mut chi_max = f64::MIN;
+    for (((i, &(d, chi)), next), &x) in range.zip(sums).zip(next).zip(xs) {
+        let mut dr = d * scale;
+        if let Some(fs) = surface {
+            // eq. (45)
+            dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+        }
+        // Not wrapped: the list's image shifts refer to the unwrapped positions.
+        *next = x + dr;
+        chi_max = chi_max.max(chi);
+    }
+    chi_max
+}
+
+/// A stage of IPST on a slab: sweep `sweep` (the sums at the positions it starts from), or
+/// its moves.
+#[derive(Clone, Copy, Debug)]
+struct SweepTask {
+    sweep: u32,
+    moves: bool,
+    slab: usize,
+}
+
+/// The test of eq. (39) on the largest chi of a sweep.
+#[derive(Clone, Copy, Debug, Default)]
+struct Convergence {
+    chi_ref: f64,
+    tol: f64,
+}
+
+impl Convergence {
+    fn met(&self, chi_max: f64) -> bool {
+        (chi_max - self.chi_ref).abs() <= self.tol * self.chi_ref
+    }
+}
+
+/// What the workers of IPST's sweeps share: on each slab, the stages done and taken, a
+/// sweep then its moves (`2 m` and `2 m + 1`), and the test of eq. (39) after each sweep's
+/// moves. A sweep's moves on a slab wait for its sweep on the slab and both next to it (whose
+/// pairs reach it), a sweep for the moves before it on the slab and both next to it (whose
+/// positions it reads), and moves for the test of the sweep before: the test needs every
+/// slab's chi, and once it is met, the positions it was met at stay as they are.
+/// Each worker takes its region's earliest stage that is ready, so that on one thread the
+/// sweeps run one after the other as in a loop.
+#[derive(Clone, Debug, Default)]
+struct SweepBoard {
+    grid: Grid,
+    /// Stages on each slab: twice the iterations at most.
+    stages: u32,
+    /// Sweeps tested and not converged.
+    tested: u32,
+    /// Slabs moved in sweep `tested`, and their largest chi.
+    moved: usize,
+    chi_max: f64,
+    test: Convergence,
+    /// The sweep whose positions met the test.
+    converged: Option<u32>,
+    failed: bool,
+}
+
+impl SweepBoard {
+    /// Readies the board for at most `max_iter` sweeps over the slabs `bounds` (their first
+    /// particles, then the number of particles) on `workers` threads.
+    fn reset(&mut self, bounds: &[usize], workers: usize, max_iter: usize, test: Convergence) {
+        self.grid.reset(bounds, workers.max(1));
+        self.stages = 2 * max_iter as u32;
+        (self.tested, self.moved, self.chi_max) = (0, 0, f64::MIN);
+        self.test = test;
+        (self.converged, self.failed) = (None, false);
+    }
+
+    /// The moves made: up to the sweep whose positions met the test, else all of them.
+    fn iterations(&self) -> usize {
+        self.converged.unwrap_or(self.tested) as usize
+    }
+
+    fn ready(&self, s: u32, k: usize) -> bool {
+        s < self.stages && self.grid.ready(s, k) && (s.is_multiple_of(2) || self.tested >= s / 2)
+    }
+
+    /// The earliest stage ready among `slabs`, on the first slab it is ready on.
+    fn pick(&self, slabs: Range<usize>) -> Option<usize> {
+        let g = &self.grid;
+        slabs.filter(|&k| self.ready(g.done[k], k)).min_by_key(|&k| g.done[k])
+    }
+}
+
+impl Board for SweepBoard {
+    type Task = SweepTask;
+    /// The largest chi of a slab's moves.
+    type Out = f64;
+
+    fn grid(&mut self) -> &mut Grid {
+        &mut self.grid
+    }
+
+    fn take(&mut self, w: usize) -> Option<SweepTask> {
+        let slab = self.pick(self.grid.regions[w].clone()).or_else(|| {
+            let roam = self.grid.roams(w, self.stages);
+            roam.then(|| self.pick(0..self.grid.tiles())).flatten()
+        })?;
+        let s = self.grid.taken[slab];
+        self.grid.taken[slab] += 1;
+        Some(SweepTask { sweep: s / 2, moves: s % 2 == 1, slab })
+    }
+
+    fn finish(&mut self, task: SweepTask, chi_max: f64, _: f64) {
+        self.grid.done[task.slab] += 1;
+        if task.moves {
+            // The largest chi (max is exact: any grouping gives the same).
+            self.chi_max = self.chi_max.max(chi_max);
+            self.moved += 1;
+            if self.moved == self.grid.tiles() {
+                if self.test.met(self.chi_max) {
+                    self.converged = Some(task.sweep);
+                } else {
+                    self.tested += 1;
+                }
+                (self.moved, self.chi_max) = (0, f64::MIN);
+            }
+        }
+    }
+
+    fn over(&self) -> bool {
+        self.failed || self.converged.is_some() || 2 * self.tested == self.stages
+    }
+
+    fn fail(&mut self) {
+        self.failed = true;
     }
 }
 
@@ -176,7 +337,10 @@ struct IpstSlab<const D: usize> {
     /// (112 bytes a particle) doubled IPST's memory, and where the step's lists and IPST's
     /// arrays no longer fit the cache together (nx = 180-300 on the host of session 37), the
     /// passes around the sweeps took 1.4-1.8x their time without IPST, and 1.0-1.5x without
-    /// the copy, from spell to spell (docs/throughput.md, session 37).
+    /// the copy, from spell to spell (docs/throughput.md, session 37). Part of that is time,
+    /// not memory: in session 40 a pause as long as the sweeps, touching no memory, slowed
+    /// the passes after it as much as the sweeps did (probably the host's other tenants
+    /// evicting what a step left in the shared cache).
     half: HalfPairs,
     pairs: IpstPairs<D>,
     spill: Vec<(u32, Vector<D>, f64)>,
@@ -344,9 +508,60 @@ pub fn ipst_chi_reference<const D: usize>(
 
 #[cfg(test)]
 mod tests {
+    use super::super::stages::take_turns;
     use super::*;
     use crate::solver::scheme::passes::build_kernel_list;
     use crate::solver::scheme::{FluidSettings, Pst, SchemeName};
+
+    /// IPST's board runs each sweep and each move of every slab once, after its inputs:
+    /// a sweep after the moves before it on its slab and both next to it, moves after the
+    /// sweeps on their slab and both next to it and after the test of the sweep before. It
+    /// stops at the first sweep whose chi meets the test, with no moves past it made, or
+    /// after `max_iter` sweeps; for 1-9 slabs on 1-3 workers taking turns (one starting
+    /// late), with chi meeting the test at sweep 0, 3 or never.
+    #[test]
+    fn the_sweep_board_runs_each_stage_once_after_its_inputs() {
+        let max_iter = 6;
+        for slabs in 1..10 {
+            for workers in 1..=3usize {
+                for meets_at in [Some(0), Some(3), None] {
+                    for late in [false, true] {
+                        let what =
+                            format!("{slabs} slabs, {workers} workers, met at {meets_at:?}, late {late}");
+                        let bounds: Vec<usize> = (0..=slabs).map(|k| k * 100).collect();
+                        let mut b = SweepBoard::default();
+                        b.reset(&bounds, workers, max_iter, Convergence { chi_ref: 1.0, tol: 0.1 });
+                        let mut ran = vec![vec![0u32; slabs]; 2 * max_iter];
+                        // chi 1.0 meets the test, 2.0 does not.
+                        let chi = |t: &SweepTask| if Some(t.sweep) == meets_at { 1.0 } else { 2.0 };
+                        let check = |b: &SweepBoard, t: SweepTask| {
+                            let m = t.sweep as usize;
+                            ran[2 * m + usize::from(t.moves)][t.slab] += 1;
+                            if t.moves {
+                                assert!(
+                                    b.tested as usize >= m,
+                                    "{what}: {t:?} before the test of the sweep before"
+                                );
+                                assert!(
+                                    meets_at.is_none_or(|c| m <= c as usize),
+                                    "{what}: {t:?} past the test met"
+                                );
+                            }
+                        };
+                        take_turns(&what, &mut b, workers, late, chi, check, |_| {});
+                        let want = meets_at.map_or(max_iter, |c| c as usize);
+                        assert_eq!(b.iterations(), want, "{what}");
+                        for (s, on) in ran.iter().enumerate() {
+                            assert!(on.iter().all(|&r| r <= 1), "{what}: stage {s} twice");
+                            if s < 2 * want + 2 && s < 2 * max_iter {
+                                assert!(on.iter().all(|&r| r == 1), "{what}: stage {s} not on every slab");
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
 
     /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
     /// slabs, equals the direct sum of every particle over its whole neighbour list (to

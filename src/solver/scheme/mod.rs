@@ -10,6 +10,7 @@ mod free_surface;
 mod ipst;
 mod passes;
 mod plan;
+mod stages;
 mod walls;
 mod wavefront;
 

@@ -223,7 +223,7 @@ impl<const D: usize> Sources<'_, D> {
 
 /// Scratch state of the fluid passes that must survive between steps without allocating:
 /// the gathered particle views and IPST's work space.
-#[derive(Clone, Debug, Default)]
+#[derive(Debug, Default)]
 pub struct FluidPasses<const D: usize> {
     pub(super) ipst: IpstWork<D>,
     /// The fluid's particles as the passes read them (IPST takes its volumes from them),

@@ -39,6 +39,7 @@ use super::passes::{
     pressure_rates, set_and_regather, shifting_dt, writes_homogenisation, FluidViews, KernelAndDensity,
     RateTerms,
 };
+use super::stages::{run_stages, Grid, Tiled, WHOLE_TILE};
 use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference};
 use crate::solver::equations::Point;
 use crate::solver::kernel::Kernel;
@@ -46,7 +47,6 @@ use crate::solver::nnps::{CellList, CHUNK};
 use crate::solver::particles::{Fluid, FluidRates};
 use std::collections::VecDeque;
 use std::ops::Range;
-use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
 
 /// The fewest tiles a wavefront step is run with (from nx = 130 or so in 2D). On the host
@@ -350,17 +350,10 @@ struct Task {
 /// first passes read it) and then from its first on. A stage on the tile next to it then
 /// finds the tile's list and views still in its own core's cache. A worker takes stages of
 /// other regions only once its own are all taken, or while some region's worker has not
-/// started (on a pool whose other threads are busy, one worker runs them all).
+/// started ([`Grid::roams`]).
 #[derive(Clone, Debug, Default)]
 struct Board {
-    /// Stages done on each tile,
-    done: Vec<u8>,
-    /// and taken by a worker (done or running).
-    taken: Vec<u8>,
-    /// The tiles of each worker's region.
-    regions: Vec<Range<usize>>,
-    /// Workers started.
-    started: usize,
+    grid: Grid,
     /// Stages done in all.
     finished: usize,
     /// For each region, its tiles whose lists are no longer read, in the order their pass B
@@ -376,177 +369,70 @@ impl Board {
     /// Readies the board for a step over `bounds` (the tiles' first particles, then the
     /// number of particles) on `workers` threads.
     fn reset(&mut self, bounds: &[usize], workers: usize) {
-        let tiles = bounds.len() - 1;
-        for v in [&mut self.done, &mut self.taken] {
-            v.clear();
-            v.resize(tiles, 0);
-        }
-        // A tile belongs to the region its middle particle falls in.
-        let n = bounds[tiles];
-        let region_of = |k: usize| ((bounds[k] + bounds[k + 1]) / 2 * workers / n.max(1)).min(workers - 1);
-        self.regions.clear();
-        self.regions.extend((0..workers).map(|w| {
-            let first = (0..tiles).find(|&k| region_of(k) >= w).unwrap_or(tiles);
-            let end = (first..tiles).find(|&k| region_of(k) > w).unwrap_or(tiles);
-            first..end
-        }));
+        self.grid.reset(bounds, workers);
         self.dead.resize_with(workers, VecDeque::new);
         self.dead.iter_mut().for_each(VecDeque::clear);
-        (self.started, self.finished, self.failed) = (0, 0, false);
+        (self.finished, self.failed) = (0, false);
         self.times = StageTimes::default();
     }
 
     /// Stages in all.
     fn stages(&self) -> usize {
-        STAGES.len() * self.done.len()
-    }
-
-    /// Whether stage `s` of tile `k` can start: it is not taken, and the stage before it
-    /// is done on the tile and on both tiles next to it (cyclically).
-    fn ready(&self, s: usize, k: usize) -> bool {
-        let n = self.done.len();
-        self.taken[k] as usize == s
-            && self.done[k] as usize == s
-            && self.done[(k + 1) % n] as usize >= s
-            && self.done[(k + n - 1) % n] as usize >= s
-    }
-
-    /// The stage worker `w` runs next, now taken; `None` if it is to wait.
-    fn take(&mut self, w: usize) -> Option<Task> {
-        let own = self.regions[w].clone();
-        let (stage, tile) = self.pick(own.clone()).or_else(|| {
-            let roam = self.started < self.regions.len()
-                || own.clone().all(|k| self.taken[k] as usize == STAGES.len());
-            roam.then(|| self.pick(0..self.done.len())).flatten()
-        })?;
-        self.taken[tile] += 1;
-        let region = self.regions.iter().position(|r| r.contains(&tile)).unwrap_or(w);
-        let dead = if stage == Stage::List { self.dead[region].pop_front() } else { None };
-        Some(Task { stage, tile, dead })
+        STAGES.len() * self.grid.tiles()
     }
 
     /// The stage one thread would run next among `tiles`: the deepest that is ready, on
     /// the first tile it is ready on; else the listing of the last tile, or of the first
     /// one not listed.
     fn pick(&self, tiles: Range<usize>) -> Option<(Stage, usize)> {
+        let g = &self.grid;
         let deepest = (1..STAGES.len())
             .rev()
-            .find_map(|s| tiles.clone().find(|&k| self.ready(s, k)).map(|k| (STAGES[s], k)));
+            .find_map(|s| tiles.clone().find(|&k| g.ready(s as u32, k)).map(|k| (STAGES[s], k)));
         deepest.or_else(|| {
             let last = tiles.end.checked_sub(1).filter(|_| !tiles.is_empty())?;
-            std::iter::once(last)
-                .chain(tiles.start..last)
-                .find(|&k| self.ready(0, k))
-                .map(|k| (Stage::List, k))
+            std::iter::once(last).chain(tiles.start..last).find(|&k| g.ready(0, k)).map(|k| (Stage::List, k))
         })
     }
+}
 
-    /// Records `task` done in `seconds`.
-    fn finish(&mut self, task: Task, seconds: f64) {
-        self.done[task.tile] += 1;
+impl super::stages::Board for Board {
+    type Task = Task;
+    type Out = ();
+
+    fn grid(&mut self) -> &mut Grid {
+        &mut self.grid
+    }
+
+    fn take(&mut self, w: usize) -> Option<Task> {
+        let own = self.grid.regions[w].clone();
+        let (stage, tile) = self.pick(own).or_else(|| {
+            let roam = self.grid.roams(w, STAGES.len() as u32);
+            roam.then(|| self.pick(0..self.grid.tiles())).flatten()
+        })?;
+        self.grid.taken[tile] += 1;
+        let dead = if stage == Stage::List { self.dead[self.grid.region_of(tile)].pop_front() } else { None };
+        Some(Task { stage, tile, dead })
+    }
+
+    fn finish(&mut self, task: Task, (): (), seconds: f64) {
+        self.grid.done[task.tile] += 1;
         self.finished += 1;
         self.times.add(task.stage, seconds);
         if task.stage == Stage::Accelerations {
-            let region = self.regions.iter().position(|r| r.contains(&task.tile)).unwrap_or(0);
+            let region = self.grid.region_of(task.tile);
             self.dead[region].push_back(task.tile);
         }
     }
-}
 
-/// Runs every stage of every tile on the threads of the current rayon pool, each stage as
-/// one task once its inputs are done, as [`Board`] hands them out (on one thread in the
-/// order one thread runs them best). Returns the board with the threads' time in each kind.
-fn run_stages(board: Board, run: &(impl Fn(Task) + Sync)) -> Board {
-    let board = Mutex::new(board);
-    let lock = || board.lock().unwrap_or_else(PoisonError::into_inner);
-    let worker = |w: usize| {
-        lock().started += 1;
-        let mut finished = None;
-        loop {
-            let task = {
-                let mut b = lock();
-                if let Some((task, seconds)) = finished.take() {
-                    b.finish(task, seconds);
-                }
-                if b.failed || b.finished == b.stages() {
-                    return;
-                }
-                b.take(w)
-            };
-            let Some(task) = task else {
-                // A stage on another thread is under way (stages take tens of microseconds
-                // or more): wait for it without giving up the core.
-                for _ in 0..64 {
-                    std::hint::spin_loop();
-                }
-                continue;
-            };
-            let clock = Instant::now();
-            let failing = FailOnUnwind(&board);
-            run(task);
-            std::mem::forget(failing);
-            finished = Some((task, clock.elapsed().as_secs_f64()));
-        }
-    };
-    on_each_thread(0, board.lock().map_or(1, |b| b.regions.len()), &worker);
-    board.into_inner().unwrap_or_else(PoisonError::into_inner)
-}
-
-/// Runs `f(w)` for `w` in `first..threads` on threads of the current rayon pool (as many
-/// as take them up: with none free, the calling thread runs each in turn). Nothing `f`
-/// runs may wait for another call of `f` to start, and `f` must not fork rayon tasks
-/// itself: a thread waiting for a forked task may run another call of `f` on top of its own.
-fn on_each_thread(first: usize, threads: usize, f: &(impl Fn(usize) + Sync)) {
-    if first + 1 >= threads {
-        f(first);
-    } else {
-        rayon::join(|| f(first), || on_each_thread(first + 1, threads, f));
-    }
-}
-
-/// Marks the board failed if a stage unwinds, so that the other workers stop rather than
-/// wait for it.
-struct FailOnUnwind<'a>(&'a Mutex<Board>);
-
-impl Drop for FailOnUnwind<'_> {
-    fn drop(&mut self) {
-        self.0.lock().unwrap_or_else(PoisonError::into_inner).failed = true;
-    }
-}
-
-/// A slice that several threads write disjoint runs of at once, while other threads may
-/// read other elements through shared references to its owner.
-struct Tiled<T> {
-    ptr: *mut T,
-    len: usize,
-}
-
-// SAFETY: elements are reached only through `run`, whose callers keep the threads' runs
-// apart.
-unsafe impl<T: Send> Send for Tiled<T> {}
-unsafe impl<T: Send> Sync for Tiled<T> {}
-
-impl<T> Tiled<T> {
-    fn new(v: &mut [T]) -> Self {
-        Self { ptr: v.as_mut_ptr(), len: v.len() }
+    fn over(&self) -> bool {
+        self.failed || self.finished == self.stages()
     }
 
-    /// The elements `r`, for this thread alone.
-    ///
-    /// # Safety
-    /// No other thread reads or writes them while the borrow lives, and the slice is alive
-    /// and not moved.
-    #[allow(clippy::mut_from_ref)]
-    unsafe fn run(&self, r: Range<usize>) -> &mut [T] {
-        assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
-        // SAFETY: in bounds (checked) and exclusive (the caller's contract).
-        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.len()) }
+    fn fail(&mut self) {
+        self.failed = true;
     }
 }
-
-/// Rayon tasks of a stage: one, the whole tile (the workers of [`run_stages`] are the
-/// parallelism, and must not fork).
-const WHOLE_TILE: usize = usize::MAX;
 
 impl<const D: usize> FluidPasses<D> {
     /// The listing, summation density, pass A with the pressure update over `dt`, and pass B
@@ -575,7 +461,7 @@ impl<const D: usize> FluidPasses<D> {
 
         // Each stage of a tile writes only that tile's elements, and reads its neighbours'
         // only once their writers are done and before their next writer starts (the
-        // dependencies of `Board::ready`; see the match below). So the slices written are
+        // dependencies of `Grid::ready`; see the match below). So the slices written are
         // handed out by tile (`Tiled`, `ChunkWriter`), and read through shared references
         // to their owners, at elements no thread is writing.
         let (rho, p) = (Tiled::new(&mut fluid.rho), Tiled::new(&mut fluid.p));
@@ -645,6 +531,7 @@ impl<const D: usize> FluidPasses<D> {
 
 #[cfg(test)]
 mod tests {
+    use super::super::stages::take_turns;
     use super::*;
     use crate::solver::math::Vector;
     use crate::solver::nnps::{Domain, NeighbourList};
@@ -669,53 +556,27 @@ mod tests {
                     let bounds: Vec<usize> = (0..=n).map(|k| k * 100).collect();
                     let mut b = Board::default();
                     b.reset(&bounds, workers);
-                    let mut running: Vec<Option<Task>> = vec![None; workers];
-                    let (mut most_open, mut turns, mut idle) = (0, 0, 0);
-                    b.started = if late { workers - 1 } else { workers };
-                    while b.finished < b.stages() {
-                        turns += 1;
-                        assert!(turns < 10 * b.stages(), "{what}: stuck");
-                        for (w, running) in running.iter_mut().enumerate() {
-                            if late && w == workers - 1 && turns < 5 {
-                                continue;
-                            }
-                            if late && w == workers - 1 && turns == 5 {
-                                b.started += 1;
-                            }
-                            if let Some(t) = running.take() {
-                                b.finish(t, 1.0);
-                            }
-                            if let Some(t) = b.take(w) {
-                                let (s, k) = (t.stage as usize, t.tile);
-                                assert_eq!(b.taken[k] as usize, s + 1, "{what}: {t:?}");
-                                assert_eq!(b.done[k] as usize, s, "{what}: {t:?} before the stage before it");
-                                for j in [(k + 1) % n, (k + n - 1) % n] {
-                                    assert!(
-                                        b.done[j] as usize >= s,
-                                        "{what}: {t:?} before its inputs on {j}"
-                                    );
-                                }
-                                *running = Some(t);
-                            } else if !late || turns > 5 {
-                                idle += 1;
-                            }
-                        }
-                        let open = b.done.iter().filter(|&&l| (1..4).contains(&l)).count();
-                        most_open = most_open.max(open);
-                        if b.finished + running.iter().flatten().count() == b.stages() {
-                            for t in running.iter_mut().filter_map(Option::take) {
-                                b.finish(t, 1.0);
-                            }
-                        }
-                    }
+                    let mut most_open = 0;
+                    let idle = take_turns(
+                        &what,
+                        &mut b,
+                        workers,
+                        late,
+                        |_| (),
+                        |_, _| {},
+                        |b| {
+                            let open = b.grid.done.iter().filter(|&&l| (1..4).contains(&l)).count();
+                            most_open = most_open.max(open);
+                        },
+                    );
                     assert!(
-                        b.done.iter().all(|&l| l == 4) && b.taken.iter().all(|&l| l == 4),
+                        b.grid.done.iter().all(|&l| l == 4) && b.grid.taken.iter().all(|&l| l == 4),
                         "{what}: every stage once"
                     );
                     if workers == 1 {
                         assert!(most_open <= 7, "{what}: {most_open} tiles open at once");
                     }
-                    let covered: usize = b.regions.iter().map(|r| r.len()).sum();
+                    let covered: usize = b.grid.regions.iter().map(|r| r.len()).sum();
                     assert_eq!(covered, n, "{what}: the regions cover the tiles");
                     idle_turns.push((workers, late, n, idle));
                 }

@@ -1,0 +1,291 @@
+//! Work in stages over tiles, runs of a body's particles in cell order, on the threads of
+//! the pool: the wavefront step's passes ([`wavefront`](super::wavefront)) and IPST's
+//! sweeps ([`ipst`](super::ipst)). A stage of a tile needs the stage before it done on the
+//! tile and on both tiles next to it (cyclically), since a particle's neighbours lie in
+//! those. Each thread owns a region of tiles and takes their stages one at a time as their
+//! inputs are done ([`Grid`]), waiting for another thread only where a stage needs one of
+//! its tiles. A stage is one task on one thread and forks nothing: a parallel loop per
+//! stage, or per sweep, ends in a join where one thread waits for the other, and on a
+//! virtual machine a waiting thread that has gone to sleep takes tens of microseconds to
+//! wake (docs/throughput.md, sessions 38-40).
+//!
+//! Which thread runs a stage never changes what it computes: every sum is over the same
+//! terms in the same order.
+
+use std::ops::Range;
+use std::sync::{Mutex, PoisonError};
+use std::time::Instant;
+
+/// The stages done and taken on each tile, and each worker's region.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Grid {
+    /// Stages done on each tile,
+    pub(super) done: Vec<u32>,
+    /// and taken by a worker (done or running).
+    pub(super) taken: Vec<u32>,
+    /// The tiles of each worker's region.
+    pub(super) regions: Vec<Range<usize>>,
+    /// Workers started.
+    pub(super) started: usize,
+}
+
+impl Grid {
+    /// Readies the grid for the tiles `bounds` (their first particles, then the number of
+    /// particles) on `workers` threads, no stage done. A tile belongs to the region its
+    /// middle particle falls in, so that the regions hold about as many particles each.
+    pub(super) fn reset(&mut self, bounds: &[usize], workers: usize) {
+        let tiles = bounds.len() - 1;
+        for v in [&mut self.done, &mut self.taken] {
+            v.clear();
+            v.resize(tiles, 0);
+        }
+        let n = bounds[tiles];
+        let region_of = |k: usize| ((bounds[k] + bounds[k + 1]) / 2 * workers / n.max(1)).min(workers - 1);
+        self.regions.clear();
+        self.regions.extend((0..workers).map(|w| {
+            let first = (0..tiles).find(|&k| region_of(k) >= w).unwrap_or(tiles);
+            let end = (first..tiles).find(|&k| region_of(k) > w).unwrap_or(tiles);
+            first..end
+        }));
+        self.started = 0;
+    }
+
+    /// Number of tiles.
+    pub(super) fn tiles(&self) -> usize {
+        self.done.len()
+    }
+
+    /// Whether stage `s` of tile `k` can start: it is not taken, and the stage before it
+    /// is done on the tile and on both tiles next to it (cyclically).
+    pub(super) fn ready(&self, s: u32, k: usize) -> bool {
+        let n = self.done.len();
+        self.taken[k] == s
+            && self.done[k] == s
+            && self.done[(k + 1) % n] >= s
+            && self.done[(k + n - 1) % n] >= s
+    }
+
+    /// Whether worker `w` may take stages of other regions: its own `stages` stages are
+    /// all taken on every tile of its region, or some worker has not started (on a pool
+    /// whose other threads are busy, one worker then runs everything, and nothing waits
+    /// for a worker that never comes).
+    pub(super) fn roams(&self, w: usize, stages: u32) -> bool {
+        self.started < self.regions.len() || self.regions[w].clone().all(|k| self.taken[k] == stages)
+    }
+
+    /// The region tile `k` belongs to.
+    pub(super) fn region_of(&self, k: usize) -> usize {
+        self.regions.iter().position(|r| r.contains(&k)).unwrap_or(0)
+    }
+}
+
+/// What the workers of [`run_stages`] share, under a mutex: which stage each takes next,
+/// and what a stage done changes.
+pub(super) trait Board: Send {
+    /// A stage of a tile.
+    type Task: Copy + Send;
+    /// What a stage returns to the board.
+    type Out: Send;
+    /// The grid of stages.
+    fn grid(&mut self) -> &mut Grid;
+    /// The stage worker `w` runs next, now taken; `None` if it is to wait.
+    fn take(&mut self, w: usize) -> Option<Self::Task>;
+    /// Records `task` done in `seconds`, with what it returned.
+    fn finish(&mut self, task: Self::Task, out: Self::Out, seconds: f64);
+    /// Whether the workers are to stop: every stage is done, the work ended early, or a
+    /// stage failed.
+    fn over(&self) -> bool;
+    /// Records that a stage unwound.
+    fn fail(&mut self);
+}
+
+/// Runs the stages `board` hands out on the threads of the current rayon pool, a worker a
+/// thread and as many workers as the grid has regions (on one thread, the calling thread
+/// runs them all in the order the board gives), until the board is over. Returns the board.
+pub(super) fn run_stages<B: Board>(mut board: B, run: &(impl Fn(B::Task) -> B::Out + Sync)) -> B {
+    let workers = board.grid().regions.len();
+    let board = Mutex::new(board);
+    let lock = || board.lock().unwrap_or_else(PoisonError::into_inner);
+    let worker = |w: usize| {
+        lock().grid().started += 1;
+        let mut finished = None;
+        loop {
+            let task = {
+                let mut b = lock();
+                if let Some((task, out, seconds)) = finished.take() {
+                    b.finish(task, out, seconds);
+                }
+                if b.over() {
+                    return;
+                }
+                b.take(w)
+            };
+            let Some(task) = task else {
+                // A stage on another thread is under way (stages take tens of microseconds
+                // or more): wait for it without giving up the core.
+                for _ in 0..64 {
+                    std::hint::spin_loop();
+                }
+                continue;
+            };
+            let clock = Instant::now();
+            let failing = FailOnUnwind(&board);
+            let out = run(task);
+            std::mem::forget(failing);
+            finished = Some((task, out, clock.elapsed().as_secs_f64()));
+        }
+    };
+    on_each_thread(0, workers.max(1), &worker);
+    board.into_inner().unwrap_or_else(PoisonError::into_inner)
+}
+
+/// Runs `f(w)` for `w` in `first..threads` on threads of the current rayon pool (as many
+/// as take them up: with none free, the calling thread runs each in turn). Nothing `f`
+/// runs may wait for another call of `f` to start, and `f` must not fork rayon tasks
+/// itself: a thread waiting for a forked task may run another call of `f` on top of its own.
+fn on_each_thread(first: usize, threads: usize, f: &(impl Fn(usize) + Sync)) {
+    if first + 1 >= threads {
+        f(first);
+    } else {
+        rayon::join(|| f(first), || on_each_thread(first + 1, threads, f));
+    }
+}
+
+/// Marks the board failed if a stage unwinds, so that the other workers stop rather than
+/// wait for it.
+struct FailOnUnwind<'a, B: Board>(&'a Mutex<B>);
+
+impl<B: Board> Drop for FailOnUnwind<'_, B> {
+    fn drop(&mut self) {
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).fail();
+    }
+}
+
+/// A slice that several threads write disjoint runs of at once, while other threads may
+/// read other elements.
+pub(super) struct Tiled<T> {
+    ptr: *mut T,
+    len: usize,
+}
+
+// SAFETY: elements are reached only through `run` and `view`, whose callers keep the
+// threads' runs apart.
+unsafe impl<T: Send> Send for Tiled<T> {}
+unsafe impl<T: Send + Sync> Sync for Tiled<T> {}
+
+impl<T> Tiled<T> {
+    pub(super) fn new(v: &mut [T]) -> Self {
+        Self { ptr: v.as_mut_ptr(), len: v.len() }
+    }
+
+    /// The elements `r`, for this thread alone.
+    ///
+    /// # Safety
+    /// No other thread reads or writes them while the borrow lives, and the slice is alive
+    /// and not moved.
+    #[allow(clippy::mut_from_ref)]
+    pub(super) unsafe fn run(&self, r: Range<usize>) -> &mut [T] {
+        assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
+        // SAFETY: in bounds (checked) and exclusive (the caller's contract).
+        unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.len()) }
+    }
+
+    /// All the elements, to read those no thread writes while the borrow lives.
+    ///
+    /// # Safety
+    /// The borrow reads only elements that no thread writes while it lives, and the slice is
+    /// alive and not moved.
+    pub(super) unsafe fn view(&self) -> &[T] {
+        // SAFETY: the whole slice, alive (the caller's contract).
+        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+    }
+}
+
+/// Rayon tasks of a stage: one, the whole tile (the workers of [`run_stages`] are the
+/// parallelism, and must not fork).
+pub(super) const WHOLE_TILE: usize = usize::MAX;
+
+/// Drives `board` (the case `what`) as `workers` workers taking turns would, a stage a turn, the last one
+/// starting at turn 4 if `late` (a test of a [`Board`]): each turn each worker finishes the
+/// stage it ran, with `out(task)`, and takes the next, which must be ready by the grid's
+/// rule (asserted here) and which `taken(board, task)` may check further; `turn(board)`
+/// sees the board after each turn. Returns the turns workers found nothing to take.
+#[cfg(test)]
+pub(super) fn take_turns<B: Board>(
+    what: &str,
+    b: &mut B,
+    workers: usize,
+    late: bool,
+    out: impl Fn(&B::Task) -> B::Out,
+    mut taken: impl FnMut(&B, B::Task),
+    mut turn: impl FnMut(&B),
+) -> usize
+where
+    B::Task: std::fmt::Debug,
+{
+    const LATE_START: usize = 4;
+    let mut running: Vec<Option<B::Task>> = vec![None; workers];
+    b.grid().started = if late { workers - 1 } else { workers };
+    let (mut turns, mut idle) = (0, 0);
+    while !b.over() {
+        turns += 1;
+        assert!(turns < 100_000, "{what}: stuck");
+        for (w, running) in running.iter_mut().enumerate() {
+            if late && w == workers - 1 {
+                match turns.cmp(&LATE_START) {
+                    std::cmp::Ordering::Less => continue,
+                    std::cmp::Ordering::Equal => b.grid().started += 1,
+                    std::cmp::Ordering::Greater => {}
+                }
+            }
+            if let Some(t) = running.take() {
+                let o = out(&t);
+                b.finish(t, o, 1.0);
+            }
+            if b.over() {
+                break;
+            }
+            let before = b.grid().taken.clone();
+            let Some(t) = b.take(w) else {
+                idle += 1;
+                continue;
+            };
+            let g = b.grid();
+            let k = (0..g.tiles()).find(|&k| g.taken[k] != before[k]).expect("a stage taken");
+            let (s, n) = (before[k], g.tiles());
+            assert_eq!(g.taken[k], s + 1, "{what}: {t:?}");
+            assert_eq!(g.done[k], s, "{what}: {t:?} before the stage before it");
+            for j in [(k + 1) % n, (k + n - 1) % n] {
+                assert!(g.done[j] >= s, "{what}: {t:?} before its inputs on {j}");
+            }
+            taken(b, t);
+            *running = Some(t);
+        }
+        turn(b);
+    }
+    idle
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Regions split the tiles by particles, in order, covering every tile once, for
+    /// tiles of equal and unequal sizes, and more workers than tiles.
+    #[test]
+    #[allow(clippy::single_range_in_vec_init)]
+    fn regions_share_out_the_particles_in_order() {
+        let mut g = Grid::default();
+        for (bounds, workers, want) in [
+            (vec![0, 100, 200, 300, 400], 2, vec![0..2, 2..4]),
+            (vec![0, 100, 200, 300, 433], 2, vec![0..2, 2..4]),
+            (vec![0, 10, 20, 400], 2, vec![0..2, 2..3]),
+            (vec![0, 100], 3, vec![0..0, 0..1, 1..1]),
+            (vec![0, 100, 200, 300], 1, vec![0..3]),
+        ] {
+            g.reset(&bounds, workers);
+            assert_eq!(g.regions, want, "{bounds:?} on {workers}");
+            assert!(g.done.iter().chain(&g.taken).all(|&s| s == 0));
+        }
+    }
+}
