@@ -278,10 +278,16 @@ fn case_simulation(variant: &str, nx: usize, kernel: &str, warmup: u64) -> Resul
     let p = taylor_green::params_from(&sets)?;
     let mut sim = taylor_green::simulation::<2>(&p)?;
     sim.set_schedule(schedule);
+    warm_up(&mut sim, warmup)?;
+    Ok(sim)
+}
+
+/// `warmup` untimed steps of `sim` on the current pool.
+fn warm_up(sim: &mut Simulation<2>, warmup: u64) -> Result<(), String> {
     for _ in 0..warmup {
         sim.step(f64::INFINITY).map_err(|d| d.reason)?;
     }
-    Ok(sim)
+    Ok(())
 }
 
 /// What a configuration's timed steps added up to.
@@ -409,7 +415,8 @@ pub fn run_case(
 
 /// Times every variant of `variants` on every thread count of `threads` at `nx` side by
 /// side in this process (`bench --interleave`): their simulations are built and warmed up
-/// (`warmup` steps) together, then stepped in turn, `rounds` times, a block of
+/// (`warmup` steps) together, on every pool each steps on, so that each thread count tunes
+/// its own schedule, then stepped in turn, `rounds` times, a block of
 /// `steps / rounds` timed steps each (after one untimed step, since the caches then hold
 /// the configuration before), each thread count on its own pool; the order of a round is
 /// reversed every other round. A slow spell of a noisy machine, even one of seconds, then
@@ -447,11 +454,20 @@ pub fn run_interleaved(
     let mut sims = Vec::new();
     for v in variants {
         let rss0 = status_kb("VmRSS:") * 1024;
-        let sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
+        let mut sim = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
         let grown = (status_kb("VmRSS:") * 1024).saturating_sub(rss0);
+        // Warmed up, and tuned, on every pool it steps on: the faster schedule depends on
+        // the number of threads.
+        for pool in pools.iter().filter(|p| p.current_num_threads() != widest.current_num_threads()) {
+            pool.install(|| warm_up(&mut sim, warmup))?;
+        }
         let copies = (1..most_copies)
-            .map(|_| widest.install(|| case_simulation(v, nx, kernel, warmup)))
-            .collect::<Result<Vec<_>, _>>()?;
+            .map(|_| {
+                let mut copy = widest.install(|| case_simulation(v, nx, kernel, warmup))?;
+                solo[0].install(|| warm_up(&mut copy, warmup))?;
+                Ok(copy)
+            })
+            .collect::<Result<Vec<_>, String>>()?;
         sims.push((sim, copies, grown));
     }
     let block = steps.div_ceil(rounds as u64).max(1);
