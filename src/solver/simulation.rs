@@ -764,7 +764,7 @@ mod tests {
         let pool = |t: usize| rayon::ThreadPoolBuilder::new().num_threads(t).build().unwrap();
         let (one, two) = (pool(1), pool(2));
         let mut sim = vortex_sized(128, SchemeName::Edac, Pst::None, RatePositions::End);
-        let mut steps = |sim: &mut Simulation<2>, n: usize| {
+        let steps = |sim: &mut Simulation<2>, n: usize| {
             let mut ran = Vec::new();
             for _ in 0..n {
                 sim.step(f64::INFINITY).unwrap();
