@@ -7,9 +7,9 @@
 //! axis, in the last layer when `i` is in the first. A loop over the pairs `j > i` of a slab
 //! adds the shares of the points of its own slab at once and sets the others aside
 //! ("spills"), which the slabs that receive them add in a fixed order once that loop is
-//! done (IPST's sweeps run the slabs as stages on the threads of the pool). Every sum then runs in an order fixed by the partition, which depends on the
-//! geometry alone: the result does not depend on the number of threads, and no two threads
-//! write the same point.
+//! done (IPST's sweeps run the slabs as stages on the threads of the pool). Every sum then
+//! runs in an order fixed by the partition, which depends on the geometry alone: the result
+//! does not depend on the number of threads, and no two threads write the same point.
 
 use super::CellList;
 use std::ops::Range;

@@ -236,7 +236,6 @@ struct SweepBoard {
     test: Convergence,
     /// The sweep whose positions met the test.
     converged: Option<u32>,
-    failed: bool,
 }
 
 impl SweepBoard {
@@ -247,23 +246,20 @@ impl SweepBoard {
         self.stages = 2 * max_iter as u32;
         (self.tested, self.moved, self.chi_max) = (0, 0, f64::MIN);
         self.test = test;
-        (self.converged, self.failed) = (None, false);
+        self.converged = None;
     }
 
     /// The moves made: up to the sweep whose positions met the test, else all of them.
     fn iterations(&self) -> usize {
         self.converged.unwrap_or(self.tested) as usize
     }
+}
 
-    fn ready(&self, s: u32, k: usize) -> bool {
-        s < self.stages && self.grid.ready(s, k) && (s.is_multiple_of(2) || self.tested >= s / 2)
-    }
-
-    /// The earliest stage ready among `slabs`, on the first slab it is ready on.
-    fn pick(&self, slabs: Range<usize>) -> Option<usize> {
-        let g = &self.grid;
-        slabs.filter(|&k| self.ready(g.done[k], k)).min_by_key(|&k| g.done[k])
-    }
+/// The slab among `slabs` with the earliest stage ready (the first such), of `stages` a
+/// slab, with `tested` sweeps tested: moves wait for the test of the sweep before.
+fn pick(g: &Grid, slabs: Range<usize>, stages: u32, tested: u32) -> Option<usize> {
+    let ready = |s: u32, k: usize| s < stages && g.ready(s, k) && (s.is_multiple_of(2) || tested >= s / 2);
+    slabs.filter(|&k| ready(g.done[k], k)).min_by_key(|&k| g.done[k])
 }
 
 impl Board for SweepBoard {
@@ -276,12 +272,8 @@ impl Board for SweepBoard {
     }
 
     fn take(&mut self, w: usize) -> Option<SweepTask> {
-        let slab = self.pick(self.grid.regions[w].clone()).or_else(|| {
-            let roam = self.grid.roams(w, self.stages);
-            roam.then(|| self.pick(0..self.grid.tiles())).flatten()
-        })?;
-        let s = self.grid.taken[slab];
-        self.grid.taken[slab] += 1;
+        let (stages, tested) = (self.stages, self.tested);
+        let (slab, s) = self.grid.take(w, stages, |g, slabs| pick(g, slabs, stages, tested))?;
         Some(SweepTask { sweep: s / 2, moves: s % 2 == 1, slab })
     }
 
@@ -303,11 +295,7 @@ impl Board for SweepBoard {
     }
 
     fn over(&self) -> bool {
-        self.failed || self.converged.is_some() || 2 * self.tested == self.stages
-    }
-
-    fn fail(&mut self) {
-        self.failed = true;
+        self.converged.is_some() || 2 * self.tested == self.stages
     }
 }
 

@@ -27,6 +27,8 @@ pub(super) struct Grid {
     pub(super) regions: Vec<Range<usize>>,
     /// Workers started.
     pub(super) started: usize,
+    /// Whether a stage unwound: the other workers then stop rather than wait for it.
+    pub(super) failed: bool,
 }
 
 impl Grid {
@@ -47,7 +49,7 @@ impl Grid {
             let end = (first..tiles).find(|&k| region_of(k) > w).unwrap_or(tiles);
             first..end
         }));
-        self.started = 0;
+        (self.started, self.failed) = (0, false);
     }
 
     /// Number of tiles.
@@ -65,11 +67,26 @@ impl Grid {
             && self.done[(k + n - 1) % n] >= s
     }
 
+    /// The tile worker `w` takes a stage of next, and the stage, now taken: the tile `pick`
+    /// chooses among its region's, else among all the tiles if the worker may take stages
+    /// of other regions ([`roams`](Self::roams)); `None` if it is to wait.
+    pub(super) fn take(
+        &mut self,
+        w: usize,
+        stages: u32,
+        pick: impl Fn(&Self, Range<usize>) -> Option<usize>,
+    ) -> Option<(usize, u32)> {
+        let own = pick(self, self.regions[w].clone());
+        let k = own.or_else(|| self.roams(w, stages).then(|| pick(self, 0..self.tiles())).flatten())?;
+        self.taken[k] += 1;
+        Some((k, self.taken[k] - 1))
+    }
+
     /// Whether worker `w` may take stages of other regions: its own `stages` stages are
     /// all taken on every tile of its region, or some worker has not started (on a pool
     /// whose other threads are busy, one worker then runs everything, and nothing waits
     /// for a worker that never comes).
-    pub(super) fn roams(&self, w: usize, stages: u32) -> bool {
+    fn roams(&self, w: usize, stages: u32) -> bool {
         self.started < self.regions.len() || self.regions[w].clone().all(|k| self.taken[k] == stages)
     }
 
@@ -92,11 +109,8 @@ pub(super) trait Board: Send {
     fn take(&mut self, w: usize) -> Option<Self::Task>;
     /// Records `task` done in `seconds`, with what it returned.
     fn finish(&mut self, task: Self::Task, out: Self::Out, seconds: f64);
-    /// Whether the workers are to stop: every stage is done, the work ended early, or a
-    /// stage failed.
+    /// Whether the workers are to stop: every stage is done, or the work ended early.
     fn over(&self) -> bool;
-    /// Records that a stage unwound.
-    fn fail(&mut self);
 }
 
 /// Runs the stages `board` hands out on the threads of the current rayon pool, a worker a
@@ -115,7 +129,7 @@ pub(super) fn run_stages<B: Board>(mut board: B, run: &(impl Fn(B::Task) -> B::O
                 if let Some((task, out, seconds)) = finished.take() {
                     b.finish(task, out, seconds);
                 }
-                if b.over() {
+                if b.grid().failed || b.over() {
                     return;
                 }
                 b.take(w)
@@ -157,7 +171,7 @@ struct FailOnUnwind<'a, B: Board>(&'a Mutex<B>);
 
 impl<B: Board> Drop for FailOnUnwind<'_, B> {
     fn drop(&mut self) {
-        self.0.lock().unwrap_or_else(PoisonError::into_inner).fail();
+        self.0.lock().unwrap_or_else(PoisonError::into_inner).grid().failed = true;
     }
 }
 
@@ -205,11 +219,12 @@ impl<T> Tiled<T> {
 /// parallelism, and must not fork).
 pub(super) const WHOLE_TILE: usize = usize::MAX;
 
-/// Drives `board` (the case `what`) as `workers` workers taking turns would, a stage a turn, the last one
-/// starting at turn 4 if `late` (a test of a [`Board`]): each turn each worker finishes the
-/// stage it ran, with `out(task)`, and takes the next, which must be ready by the grid's
-/// rule (asserted here) and which `taken(board, task)` may check further; `turn(board)`
-/// sees the board after each turn. Returns the turns workers found nothing to take.
+/// Drives `board` (the case `what`) as `workers` workers taking turns would, a stage a
+/// turn, the last one starting at turn 4 if `late` (a test of a [`Board`]): each turn each
+/// worker finishes the stage it ran, with `out(task)`, and takes the next, which must be
+/// ready by the grid's rule (asserted here) and which `taken(board, task)` may check
+/// further; `turn(board)` sees the board after each turn. Returns the turns workers found
+/// nothing to take.
 #[cfg(test)]
 pub(super) fn take_turns<B: Board>(
     what: &str,

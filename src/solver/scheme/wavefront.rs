@@ -369,7 +369,7 @@ struct Task {
 /// first passes read it) and then from its first on. A stage on the tile next to it then
 /// finds the tile's list and views still in its own core's cache. A worker takes stages of
 /// other regions only once its own are all taken, or while some region's worker has not
-/// started ([`Grid::roams`]).
+/// started ([`Grid::take`]).
 #[derive(Clone, Debug, Default)]
 struct Board {
     grid: Grid,
@@ -380,8 +380,6 @@ struct Board {
     dead: Vec<VecDeque<usize>>,
     /// The threads' seconds in each kind of stage.
     times: StageTimes,
-    /// Whether a stage panicked: the other workers then stop.
-    failed: bool,
 }
 
 impl Board {
@@ -391,7 +389,7 @@ impl Board {
         self.grid.reset(bounds, workers);
         self.dead.resize_with(workers, VecDeque::new);
         self.dead.iter_mut().for_each(VecDeque::clear);
-        (self.finished, self.failed) = (0, false);
+        self.finished = 0;
         self.times = StageTimes::default();
     }
 
@@ -399,20 +397,17 @@ impl Board {
     fn stages(&self) -> usize {
         STAGES.len() * self.grid.tiles()
     }
+}
 
-    /// The stage one thread would run next among `tiles`: the deepest that is ready, on
-    /// the first tile it is ready on; else the listing of the last tile, or of the first
-    /// one not listed.
-    fn pick(&self, tiles: Range<usize>) -> Option<(Stage, usize)> {
-        let g = &self.grid;
-        let deepest = (1..STAGES.len())
-            .rev()
-            .find_map(|s| tiles.clone().find(|&k| g.ready(s as u32, k)).map(|k| (STAGES[s], k)));
-        deepest.or_else(|| {
-            let last = tiles.end.checked_sub(1).filter(|_| !tiles.is_empty())?;
-            std::iter::once(last).chain(tiles.start..last).find(|&k| g.ready(0, k)).map(|k| (Stage::List, k))
-        })
-    }
+/// The tile whose stage one thread would run next among `tiles`: the deepest stage that is
+/// ready, on the first tile it is ready on; else the listing of the last tile, or of the
+/// first one not listed.
+fn pick(g: &Grid, tiles: Range<usize>) -> Option<usize> {
+    let deepest = (1..STAGES.len() as u32).rev().find_map(|s| tiles.clone().find(|&k| g.ready(s, k)));
+    deepest.or_else(|| {
+        let last = tiles.end.checked_sub(1).filter(|_| !tiles.is_empty())?;
+        std::iter::once(last).chain(tiles.start..last).find(|&k| g.ready(0, k))
+    })
 }
 
 impl super::stages::Board for Board {
@@ -424,12 +419,8 @@ impl super::stages::Board for Board {
     }
 
     fn take(&mut self, w: usize) -> Option<Task> {
-        let own = self.grid.regions[w].clone();
-        let (stage, tile) = self.pick(own).or_else(|| {
-            let roam = self.grid.roams(w, STAGES.len() as u32);
-            roam.then(|| self.pick(0..self.grid.tiles())).flatten()
-        })?;
-        self.grid.taken[tile] += 1;
+        let (tile, s) = self.grid.take(w, STAGES.len() as u32, pick)?;
+        let stage = STAGES[s as usize];
         let dead = if stage == Stage::List { self.dead[self.grid.region_of(tile)].pop_front() } else { None };
         Some(Task { stage, tile, dead })
     }
@@ -445,11 +436,7 @@ impl super::stages::Board for Board {
     }
 
     fn over(&self) -> bool {
-        self.failed || self.finished == self.stages()
-    }
-
-    fn fail(&mut self) {
-        self.failed = true;
+        self.finished == self.stages()
     }
 }
 
@@ -541,7 +528,7 @@ impl<const D: usize> FluidPasses<D> {
             }
         };
         let board = run_stages(board, &run);
-        debug_assert!(!board.failed && board.finished == board.stages(), "every stage ran");
+        debug_assert!(!board.grid.failed && board.finished == board.stages(), "every stage ran");
         let times = board.times.scaled(clock.elapsed().as_secs_f64());
         wave.board = board;
         times
