@@ -12,6 +12,7 @@
 mod brute;
 mod cell_list;
 mod filter;
+mod gather;
 mod neighbour_list;
 mod slabs;
 
@@ -19,6 +20,7 @@ pub use brute::brute_force_neighbours;
 pub use cell_list::CellList;
 /// The implementations of the list build's distance test (same bits; the fastest is used).
 pub use filter::Path as DistanceTest;
+pub use gather::Gather;
 pub use neighbour_list::{ChunkWriter, HalfPairs, Listed, NeighbourList, PairSlices, CHUNK};
 pub use slabs::Slabs;
 

@@ -6,7 +6,7 @@
 //! gradient factor there: the kernel is then evaluated once per pair and step).
 
 use super::filter;
-use super::CellList;
+use super::{CellList, Gather};
 use crate::solver::math::Vector;
 use rayon::prelude::*;
 
@@ -323,19 +323,20 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         points: &[Vector<D>],
         mut f: F,
     ) {
-        self.for_each_with(i, xi, points, points, |j, xij, r2, p, _| f(j, xij, r2, p));
+        self.for_each_with(i, xi, points, points.into(), |j, xij, r2, p, _| f(j, xij, r2, p));
     }
 
     /// As [`for_each_from`](Self::for_each_from), also handing `f` each neighbour's record
     /// `records[j]`: the loop of every pass, which reads a neighbour's position and record
-    /// with one bounds check a call instead of two a pair.
+    /// with one bounds check a call instead of two a pair. Only the neighbours' records are
+    /// read (other threads may be writing others: the wavefront step's tiles).
     #[inline(always)]
     pub fn for_each_with<T, F: FnMut(usize, Vector<D>, f64, &P, &T)>(
         &self,
         i: usize,
         xi: Vector<D>,
         points: &[Vector<D>],
-        records: &[T],
+        records: Gather<'_, T>,
         mut f: F,
     ) {
         assert!(
@@ -354,10 +355,14 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
-    /// The chunk holding point `i` and the range of its entries in it.
+    /// The chunk holding point `i` and the range of its entries in it. The chunk alone is
+    /// borrowed, not the array of all (which a [`ChunkWriter`] may be filling elsewhere).
     #[inline(always)]
     fn range(&self, i: usize) -> (&Chunk<D, P>, std::ops::Range<usize>) {
-        let chunk = &self.chunks[i / CHUNK];
+        let c = i / CHUNK;
+        assert!(c < self.chunks.len(), "point {i} of a list of {} chunks", self.chunks.len());
+        // SAFETY: in bounds (checked); `Vec::as_ptr` borrows no other chunk.
+        let chunk = unsafe { &*self.chunks.as_ptr().add(c) };
         let l = i % CHUNK;
         (chunk, chunk.start[l] as usize..chunk.start[l + 1] as usize)
     }
@@ -366,9 +371,14 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     /// the entry's periodic image (the one formula every pass uses, so that all see the
     /// same bits).
     #[inline(always)]
-    fn pair(shifts: &[Vector<D>; CODES], e: u32, xi: Vector<D>, points: &[Vector<D>]) -> (usize, Vector<D>) {
+    fn pair(
+        shifts: &[Vector<D>; CODES],
+        e: u32,
+        xi: Vector<D>,
+        points: Gather<'_, Vector<D>>,
+    ) -> (usize, Vector<D>) {
         let j = (e & J_MASK) as usize;
-        (j, Self::difference(shifts, e, xi, &points[j]))
+        (j, Self::difference(shifts, e, xi, points.get(j)))
     }
 
     /// `x_ij` of entry `e` for a query at `xi` and a neighbour at `xj`.
@@ -400,7 +410,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let (chunk, range) = self.range(i);
         let entries = &chunk.entries[range];
         let n = entries.len();
-        let shifts = self.shift_table();
+        let (shifts, points) = (self.shift_table(), points.into());
         for ((&e, xij), value) in entries.iter().zip(&mut out.xij[..n]).zip(&mut out.value[..n]) {
             let j;
             (j, *xij) = Self::pair(shifts, e, xi, points);
@@ -418,7 +428,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         half: &HalfPairs,
         i: usize,
         xi: Vector<D>,
-        points: &[Vector<D>],
+        points: Gather<'_, Vector<D>>,
         xij: &mut [Vector<D>],
     ) -> usize {
         let entries = half.entries(i);
@@ -675,7 +685,7 @@ mod tests {
             for i in 0..pts.len() {
                 let half = if i < split { &first } else { &second };
                 let mut xij = vec![Vector::zeros(); nl.count(i)];
-                let m = nl.write_half_pairs(half, i, pts[i], &pts, &mut xij);
+                let m = nl.write_half_pairs(half, i, pts[i], pts[..].into(), &mut xij);
                 assert_eq!(m, half.count(i));
                 let span = half.span(i);
                 assert_eq!(span.len(), m);
@@ -701,7 +711,7 @@ mod tests {
         cells.update(&pts);
         let mut nl = NeighbourList::<2>::new();
         nl.build(&cells, &pts, |_, _| ());
-        nl.for_each_with(0, pts[0], &pts, &pts[..99], |_, _, _, _, _| ());
+        nl.for_each_with(0, pts[0], &pts, pts[..99].into(), |_, _, _, _, _| ());
     }
 
     #[test]
@@ -733,7 +743,7 @@ mod tests {
                 });
                 // The loop with a record a point sees the same pairs and hands each its record.
                 let mut with = Vec::new();
-                nl.for_each_with(i, pts[i], &pts, &pts, |j, xij, _, _, xj| {
+                nl.for_each_with(i, pts[i], &pts, pts[..].into(), |j, xij, _, _, xj| {
                     assert_eq!(*xj, pts[j]);
                     with.push((j, xij));
                 });

@@ -16,7 +16,7 @@ use crate::solver::equations::{
 };
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
-use crate::solver::nnps::{CellList, Listed, NeighbourList};
+use crate::solver::nnps::{CellList, Gather, Listed, NeighbourList};
 use crate::solver::particles::{Fluid, FluidRates};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
@@ -193,11 +193,17 @@ pub(super) struct Sources<'a, const D: usize> {
     h: f64,
     x: &'a [Vector<D>],
     nl: &'a KernelList<D>,
-    pts: &'a [Point<D>],
+    /// Read one at a time: the wavefront step writes other tiles' meanwhile.
+    pts: Gather<'a, Point<D>>,
     walls: Option<(&'a WallSet<D>, &'a [Point<D>], &'a [Point<D>])>,
 }
 
-impl<const D: usize> Sources<'_, D> {
+impl<'a, const D: usize> Sources<'a, D> {
+    /// The fluid's own particles, without walls, their views read from `pts`.
+    pub(super) fn fluid_only(fluid: &'a Fluid<D>, nl: &'a KernelList<D>, pts: Gather<'a, Point<D>>) -> Self {
+        Self { h: fluid.h, x: &fluid.x, nl, pts, walls: None }
+    }
+
     #[inline(always)]
     fn for_each(&self, i: usize, mut f: impl FnMut(&Pair<D>, &Point<D>, &Point<D>, bool)) {
         let h = self.h;
@@ -264,7 +270,7 @@ impl<const D: usize> FluidPasses<D> {
             h: fluid.h,
             x: &fluid.x,
             nl,
-            pts: &self.points,
+            pts: self.points[..].into(),
             walls: walls.map(|ws| (ws, &self.wall_div[..], &self.wall_visc[..])),
         }
     }
@@ -352,66 +358,63 @@ impl<const D: usize> FluidPasses<D> {
         rates: &mut FluidRates<D>,
         dt: f64,
     ) {
-        self.gather(fluid, nl, walls);
+        let src = self.gather(fluid, nl, walls);
         rates.a_c_dt = shifting_dt(s, dt);
         let a_c = if writes_homogenisation(s) { &mut rates.a_c[..] } else { &mut [] };
-        self.write_accelerations(fluid, nl, walls, surface, s, dt, 0, &mut rates.du, a_c, MIN_LEN);
+        write_accelerations(&src, fluid, surface, s, dt, 0, &mut rates.du, a_c, MIN_LEN);
     }
+}
 
-    /// Pass B over the gathered points, for the particles from `first` on: one per element
-    /// of `du`, with their homogenisation accelerations in `a_c` unless it is empty, in
-    /// rayon tasks of at least `task_len` particles.
-    #[allow(clippy::too_many_arguments)]
-    pub(super) fn write_accelerations(
-        &self,
-        fluid: &Fluid<D>,
-        nl: &KernelList<D>,
-        walls: Option<&WallSet<D>>,
-        surface: Option<&SurfaceFields<D>>,
-        s: &FluidScheme,
-        dt: f64,
-        first: usize,
-        du: &mut [Vector<D>],
-        a_c: &mut [Vector<D>],
-        task_len: usize,
-    ) {
-        let src = self.sources(fluid, nl, walls);
-        let g = s.gravity_vector::<D>();
-        let shifting = s.transport.map(|t| t.shifting);
-        let sun_prefactor = match shifting {
-            // -(Ma c0) 2h / dt, eq. (36)
-            Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
-            _ => 0.0,
-        };
-        let terms = AccelTerms::new(s);
-        // The fluid's mean pressure, if it is the reference: summed in particle order, so
-        // that it does not depend on the thread count.
-        let global_mean = (s.pressure_reference == PressureReference::GlobalMean)
-            .then(|| fluid.p.iter().sum::<f64>() / fluid.len() as f64);
-        let rate = |i: usize| -> (Vector<D>, Vector<D>) {
-            let sums = with_accelerations_plan!(terms.plan, P => terms.sums::<P, D>(&src, i));
-            let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
-            // A reference pressure (the neighbours' mean for BQL) is constant over the
-            // sum, so it is applied once here (c_ref is zero without one).
-            acc += c_ref * global_mean.unwrap_or(p_sum / n_nb.max(1) as f64);
-            if matches!(shifting, Some(Shifting::Sun2019 { .. })) {
-                ac *= sun_prefactor;
-            }
-            if let Some(fs) = surface {
-                // eq. (44)
-                ac = free_surface::adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
-            }
-            (acc + g, ac)
-        };
-        if a_c.is_empty() {
-            du.par_iter_mut().enumerate().with_min_len(task_len).for_each(|(k, du)| *du = rate(first + k).0);
-        } else {
-            du.par_iter_mut()
-                .zip(a_c.par_iter_mut())
-                .enumerate()
-                .with_min_len(task_len)
-                .for_each(|(k, (du, ac))| (*du, *ac) = rate(first + k));
+/// Pass B over the gathered points, for the particles from `first` on: one per element
+/// of `du`, with their homogenisation accelerations in `a_c` unless it is empty, in
+/// rayon tasks of at least `task_len` particles.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn write_accelerations<const D: usize>(
+    src: &Sources<'_, D>,
+    fluid: &Fluid<D>,
+    surface: Option<&SurfaceFields<D>>,
+    s: &FluidScheme,
+    dt: f64,
+    first: usize,
+    du: &mut [Vector<D>],
+    a_c: &mut [Vector<D>],
+    task_len: usize,
+) {
+    let g = s.gravity_vector::<D>();
+    let shifting = s.transport.map(|t| t.shifting);
+    let sun_prefactor = match shifting {
+        // -(Ma c0) 2h / dt, eq. (36)
+        Some(Shifting::Sun2019 { ma_c0, .. }) => -ma_c0 * 2.0 * fluid.h / dt,
+        _ => 0.0,
+    };
+    let terms = AccelTerms::new(s);
+    // The fluid's mean pressure, if it is the reference: summed in particle order, so
+    // that it does not depend on the thread count.
+    let global_mean = (s.pressure_reference == PressureReference::GlobalMean)
+        .then(|| fluid.p.iter().sum::<f64>() / fluid.len() as f64);
+    let rate = |i: usize| -> (Vector<D>, Vector<D>) {
+        let sums = with_accelerations_plan!(terms.plan, P => terms.sums::<P, D>(src, i));
+        let AccelSums { mut acc, mut ac, c_ref, p_sum, n_nb } = sums;
+        // A reference pressure (the neighbours' mean for BQL) is constant over the
+        // sum, so it is applied once here (c_ref is zero without one).
+        acc += c_ref * global_mean.unwrap_or(p_sum / n_nb.max(1) as f64);
+        if matches!(shifting, Some(Shifting::Sun2019 { .. })) {
+            ac *= sun_prefactor;
         }
+        if let Some(fs) = surface {
+            // eq. (44)
+            ac = free_surface::adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
+        }
+        (acc + g, ac)
+    };
+    if a_c.is_empty() {
+        du.par_iter_mut().enumerate().with_min_len(task_len).for_each(|(k, du)| *du = rate(first + k).0);
+    } else {
+        du.par_iter_mut()
+            .zip(a_c.par_iter_mut())
+            .enumerate()
+            .with_min_len(task_len)
+            .for_each(|(k, (du, ac))| (*du, *ac) = rate(first + k));
     }
 }
 
@@ -469,7 +472,7 @@ impl RateTerms {
     /// the loops over the fluid and the walls.
     #[inline(always)]
     fn sums<const P: u32, const D: usize>(&self, src: &Sources<'_, D>, i: usize) -> (f64, f64) {
-        let a = &src.pts[i];
+        let a = src.pts.get(i);
         let mut sums = (0.0, 0.0);
         src.for_each(
             i,
@@ -576,7 +579,7 @@ impl AccelTerms {
     /// Particle `i`'s sums over its sources under plan `P`.
     #[inline(always)]
     fn sums<const P: u32, const D: usize>(&self, src: &Sources<'_, D>, i: usize) -> AccelSums<D> {
-        let a = &src.pts[i];
+        let a = src.pts.get(i);
         let mut sums = AccelSums::zero();
         src.for_each(
             i,

@@ -12,6 +12,7 @@
 //! Which thread runs a stage never changes what it computes: every sum is over the same
 //! terms in the same order.
 
+use crate::solver::nnps::Gather;
 use std::ops::Range;
 use std::sync::{Mutex, PoisonError};
 use std::time::Instant;
@@ -204,14 +205,25 @@ impl<T> Tiled<T> {
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.len()) }
     }
 
-    /// All the elements, to read those no thread writes while the borrow lives.
+    /// All the elements, to read one at a time those no thread writes meanwhile (a `&[T]`
+    /// of all would read every element as it is made, while other threads write some).
     ///
     /// # Safety
-    /// The borrow reads only elements that no thread writes while it lives, and the slice is
+    /// No element read through the result is written while it lives, and the slice is
     /// alive and not moved.
-    pub(super) unsafe fn view(&self) -> &[T] {
+    pub(super) unsafe fn gather(&self) -> Gather<'_, T> {
         // SAFETY: the whole slice, alive (the caller's contract).
-        unsafe { std::slice::from_raw_parts(self.ptr, self.len) }
+        unsafe { Gather::from_raw(self.ptr, self.len) }
+    }
+
+    /// The elements `r`, to read.
+    ///
+    /// # Safety
+    /// No thread writes them while the borrow lives, and the slice is alive and not moved.
+    pub(super) unsafe fn read(&self, r: Range<usize>) -> &[T] {
+        assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
+        // SAFETY: in bounds (checked), not written (the caller's contract).
+        unsafe { std::slice::from_raw_parts(self.ptr.add(r.start), r.len()) }
     }
 }
 
@@ -284,6 +296,108 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A board of `stages` stages on each tile, the shallowest ready one first.
+    #[derive(Debug)]
+    struct Ring {
+        grid: Grid,
+        stages: u32,
+    }
+
+    impl Board for Ring {
+        type Task = (usize, u32);
+        type Out = ();
+        fn grid(&mut self) -> &mut Grid {
+            &mut self.grid
+        }
+        fn take(&mut self, w: usize) -> Option<(usize, u32)> {
+            let stages = self.stages;
+            let pick = |g: &Grid, tiles: Range<usize>| {
+                tiles.filter(|&k| g.taken[k] < stages && g.ready(g.taken[k], k)).min_by_key(|&k| g.taken[k])
+            };
+            self.grid.take(w, stages, pick)
+        }
+        fn finish(&mut self, (k, _): (usize, u32), _: (), _: f64) {
+            self.grid.done[k] += 1;
+        }
+        fn over(&self) -> bool {
+            self.grid.done.iter().all(|&s| s == self.stages)
+        }
+    }
+
+    /// `(x[i - 1] + 2 x[i] + x[i + 1]) / 4` on a ring.
+    fn smooth(x: Gather<'_, f64>, i: usize) -> f64 {
+        let n = x.len();
+        (x.get((i + n - 1) % n) + 2.0 * x.get(i) + x.get((i + 1) % n)) * 0.25
+    }
+
+    /// Stages on the threads compute what a loop computes, bit for bit, with the access
+    /// pattern of IPST's moves: stage `s` of a tile reads buffer `s % 2` on the tile and both
+    /// next to it (through [`Tiled::gather`], while other threads write other tiles) and writes
+    /// its tile of the other buffer (through [`Tiled::run`]). Under Miri (`cargo +nightly miri
+    /// test --lib stages`) this also checks the shared access to the buffers.
+    #[test]
+    fn stages_on_threads_compute_what_a_loop_computes() {
+        let (sizes, stages): (&[usize], u32) =
+            if cfg!(miri) { (&[2, 3, 1, 2, 4], 4) } else { (&[5, 40, 1, 17, 9, 33, 2], 25) };
+        let mut bounds = vec![0];
+        bounds.extend(sizes.iter().scan(0, |end, &s| {
+            *end += s;
+            Some(*end)
+        }));
+        let n = bounds[sizes.len()];
+        let start: Vec<f64> = (0..n).map(|i| ((i * i) % 7) as f64 + 0.1 * i as f64).collect();
+        let mut want = start.clone();
+        for _ in 0..stages {
+            want = (0..n).map(|i| smooth(want[..].into(), i)).collect();
+        }
+        for threads in 1..=3 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let (mut a, mut b) = (start.clone(), vec![0.0; n]);
+            let buffers = [Tiled::new(&mut a), Tiled::new(&mut b)];
+            let mut grid = Grid::default();
+            grid.reset(&bounds, threads.min(sizes.len()));
+            let run = |(k, s): (usize, u32)| {
+                let tile = bounds[k]..bounds[k + 1];
+                // SAFETY: the grid runs stage s of tile k after stage s - 1 of it and both
+                // its neighbours (which wrote what this reads) and before stage s + 1 of them
+                // (which overwrite it), and no other stage writes tile k of this buffer.
+                let (from, to) = unsafe {
+                    (buffers[s as usize % 2].gather(), buffers[(s as usize + 1) % 2].run(tile.clone()))
+                };
+                for (i, y) in tile.zip(to) {
+                    *y = smooth(from, i);
+                }
+            };
+            let board = pool.install(|| run_stages(Ring { grid, stages }, &run));
+            assert!(board.over() && !board.grid.failed);
+            let got = if stages % 2 == 0 { &a } else { &b };
+            assert!(got.iter().zip(&want).all(|(g, w)| g.to_bits() == w.to_bits()), "{threads} threads");
+        }
+    }
+
+    /// A stage that panics ends the run with its panic on every thread count, rather than
+    /// leaving the other workers waiting for it.
+    #[test]
+    fn a_stage_that_panics_stops_the_other_workers() {
+        let bounds = [0, 2, 4, 6, 8];
+        for threads in 1..=3 {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut grid = Grid::default();
+            grid.reset(&bounds, threads);
+            let run = |(k, s): (usize, u32)| {
+                assert!(!(k == 2 && s == 1), "stage 1 of tile 2 fails");
+            };
+            let result = pool.install(|| {
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                    run_stages(Ring { grid, stages: 3 }, &run)
+                }))
+            });
+            let message = result.expect_err("the panic reaches the caller");
+            let text = message.downcast_ref::<&str>().copied();
+            assert_eq!(text, Some("stage 1 of tile 2 fails"), "{threads} threads");
+        }
+    }
 
     /// Regions split the tiles by particles, in order, covering every tile once, for
     /// tiles of equal and unequal sizes, and more workers than tiles.

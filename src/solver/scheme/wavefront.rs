@@ -36,8 +36,8 @@
 //! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
 
 use super::passes::{
-    pressure_rates, set_and_regather, shifting_dt, writes_homogenisation, FluidViews, KernelAndDensity,
-    RateTerms,
+    pressure_rates, set_and_regather, shifting_dt, write_accelerations, writes_homogenisation, FluidViews,
+    KernelAndDensity, RateTerms, Sources,
 };
 use super::stages::{run_stages, Grid, Tiled, WHOLE_TILE};
 use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference};
@@ -468,16 +468,16 @@ impl<const D: usize> FluidPasses<D> {
         // Each stage of a tile writes only that tile's elements, and reads its neighbours'
         // only once their writers are done and before their next writer starts (the
         // dependencies of `Grid::ready`; see the match below). So the slices written are
-        // handed out by tile (`Tiled`, `ChunkWriter`), and read through shared references
-        // to their owners, at elements no thread is writing.
+        // handed out by tile (`Tiled`, `ChunkWriter`), and read element by element (the
+        // views through `Tiled::gather`, the list chunk by chunk), never through a reference
+        // to a whole array, whose making would read the elements other threads write.
         let (rho, p) = (Tiled::new(&mut fluid.rho), Tiled::new(&mut fluid.p));
         let points = Tiled::new(&mut self.points);
         let density = Tiled::new(fluid_density);
         let (dp, du) = (Tiled::new(&mut rates.dp), Tiled::new(&mut rates.du));
         let a_c = Tiled::new(if writes_ac { &mut rates.a_c[..] } else { &mut [] });
         let writer = list.chunk_writer();
-        let (fluid, passes, list, tiles): (&Fluid<D>, &Self, &KernelList<D>, &Wavefront) =
-            (fluid, self, list, wave);
+        let (fluid, list, tiles): (&Fluid<D>, &KernelList<D>, &Wavefront) = (fluid, list, wave);
         let views = FluidViews::of(fluid);
         let listing = KernelAndDensity::new(fluid, kernel);
         let chunks_of = |k: usize| tiles.range(k).start / CHUNK..tiles.range(k).end.div_ceil(CHUNK);
@@ -508,23 +508,31 @@ impl<const D: usize> FluidPasses<D> {
                     let own = (points.run(r.clone()), rho.run(r.clone()), p.run(r.clone()));
                     set_and_regather(views, r.start, own, |i, rho, _| *rho = rho_k[i - r.start], WHOLE_TILE);
                 },
-                Stage::Rates => {
-                    let src = passes.sources(fluid, list, None);
-                    pressure_rates(&terms, &src, r.start, unsafe { dp.run(r.clone()) }, WHOLE_TILE);
-                }
+                Stage::Rates => unsafe {
+                    let src = Sources::fluid_only(fluid, list, points.gather());
+                    pressure_rates(&terms, &src, r.start, dp.run(r.clone()), WHOLE_TILE);
+                },
                 Stage::Update => unsafe {
                     // eq. (57)
                     let dp_k = &*dp.run(r.clone());
                     let own = (points.run(r.clone()), rho.run(r.clone()), p.run(r.clone()));
                     set_and_regather(views, r.start, own, |i, _, p| *p += dt * dp_k[i - r.start], WHOLE_TILE);
                 },
-                Stage::Accelerations => {
-                    let a_c = if writes_ac { unsafe { a_c.run(r.clone()) } } else { &mut [] };
-                    let du = unsafe { du.run(r.clone()) };
-                    passes.write_accelerations(
-                        fluid, list, None, None, scheme, dt_accel, r.start, du, a_c, WHOLE_TILE,
+                Stage::Accelerations => unsafe {
+                    let src = Sources::fluid_only(fluid, list, points.gather());
+                    let a_c = if writes_ac { a_c.run(r.clone()) } else { &mut [] };
+                    write_accelerations(
+                        &src,
+                        fluid,
+                        None,
+                        scheme,
+                        dt_accel,
+                        r.start,
+                        du.run(r.clone()),
+                        a_c,
+                        WHOLE_TILE,
                     );
-                }
+                },
             }
         };
         let board = run_stages(board, &run);
