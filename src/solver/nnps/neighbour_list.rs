@@ -11,8 +11,10 @@ use crate::solver::math::Vector;
 use rayon::prelude::*;
 
 /// Particles per build task; the lists are stored per chunk so building allocates nothing
-/// once the chunks have grown, and the result does not depend on the thread count.
-pub const CHUNK: usize = 512;
+/// once the chunks have grown, and the result does not depend on the thread count. (Under
+/// Miri, smaller, so that a small body makes the wavefront's tiles, two chunks a tile at
+/// least.)
+pub const CHUNK: usize = if cfg!(miri) { 64 } else { 512 };
 /// Bits of an entry holding the neighbour index (the rest hold the image code).
 const J_BITS: u32 = 26;
 const J_MASK: u32 = (1 << J_BITS) - 1;
