@@ -334,8 +334,9 @@ mod tests {
     /// Stages on the threads compute what a loop computes, bit for bit, with the access
     /// pattern of IPST's moves: stage `s` of a tile reads buffer `s % 2` on the tile and both
     /// next to it (through [`Tiled::gather`], while other threads write other tiles) and writes
-    /// its tile of the other buffer (through [`Tiled::run`]). Under Miri (`cargo +nightly miri
-    /// test --lib stages`) this also checks the shared access to the buffers.
+    /// its tile of the other buffer (through [`Tiled::run`]). Under Miri
+    /// (`MIRIFLAGS=-Zmiri-tree-borrows cargo +nightly miri test --lib stages`; Stacked Borrows
+    /// stops in rayon's deque first) this also checks the shared access to the buffers.
     #[test]
     fn stages_on_threads_compute_what_a_loop_computes() {
         let (sizes, stages): (&[usize], u32) =

@@ -294,11 +294,11 @@ impl Tuner {
                     best = Some((schedule, m));
                 }
                 if schedule == Schedule::Wavefront {
-                    tiles = Some((schedule, m));
+                    tiles = Some(m);
                 }
             }
             self.chosen = match (best, tiles) {
-                (Some(b), Some(t)) if t.1 <= b.1 * (1.0 + SWEEPS_MARGIN) => Some(t.0),
+                (Some((_, b)), Some(t)) if t <= b * (1.0 + SWEEPS_MARGIN) => Some(Schedule::Wavefront),
                 (b, _) => b.map(|b| b.0),
             };
         }
