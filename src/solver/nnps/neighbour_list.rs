@@ -759,4 +759,70 @@ mod tests {
             assert_eq!(nl.pairs(), brute.iter().map(Vec::len).sum::<usize>(), "{n} points");
         }
     }
+
+    /// A [`ChunkWriter`] used as the wavefront step uses it: two threads list runs of
+    /// chunks at once; then one hands a listed chunk's payload storage to the last chunk and
+    /// lists it while the other reads the chunks between. The list equals one build; the
+    /// chunk handed on keeps its pairs and refuses its payload. (Under Miri, which checks
+    /// the writer's shared access: `MIRIFLAGS=-Zmiri-tree-borrows cargo +nightly miri test
+    /// --lib chunks_listed`.)
+    #[test]
+    fn chunks_listed_on_two_threads_and_recycled_equal_one_build() {
+        let n = 4 * CHUNK;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let d = Domain { min: [0.0, 0.0], max: [1.0, 1.0], periodic: [true, true] };
+        let pts: Vec<Vector<2>> = (0..n).map(|_| Vector::<2>::new(rng.gen(), rng.gen())).collect();
+        // Some twelve neighbours a point.
+        let mut cells = CellList::new(d, 2.0 / (n as f64).sqrt());
+        cells.update(&pts);
+        let copy = |r2: &[f64], out: &mut [f64]| out.copy_from_slice(r2);
+        let count = |l: Listed<'_, f64>| l.iter().count();
+        let mut whole = NeighbourList::<2, f64>::new();
+        let mut counts = vec![0; n];
+        whole.build_reducing(&cells, &pts, copy, &mut counts, count);
+        let pairs = |nl: &NeighbourList<2, f64>, i: usize| {
+            let mut v = Vec::new();
+            nl.for_each(i, &pts, |j, xij, _, &p| v.push((j, xij, p)));
+            v
+        };
+
+        let mut nl = NeighbourList::<2, f64>::new();
+        assert_eq!(nl.begin(&cells, n), 0..4);
+        let writer = nl.chunk_writer();
+        let nl = &nl;
+        let mut got = vec![0; n];
+        let (first, rest) = got.split_at_mut(2 * CHUNK);
+        let (third, last) = rest.split_at_mut(CHUNK);
+        let listed = std::sync::Barrier::new(2);
+        std::thread::scope(|s| {
+            s.spawn(|| {
+                // SAFETY: chunks 0 and 1, then 0 and 3, are this thread's alone.
+                unsafe { writer.build_chunks(nl, &cells, &pts, copy, 0..2, first, count) };
+                listed.wait();
+                unsafe {
+                    writer.recycle(0, 3);
+                    writer.build_chunks(nl, &cells, &pts, copy, 3..4, last, count);
+                }
+            });
+            s.spawn(|| {
+                // SAFETY: chunk 2 is this thread's alone, and chunks 1 and 2 are only read
+                // once both threads listed theirs.
+                unsafe { writer.build_chunks(nl, &cells, &pts, copy, 2..3, third, count) };
+                listed.wait();
+                for i in CHUNK..3 * CHUNK {
+                    assert_eq!(pairs(nl, i), pairs(&whole, i), "point {i}, read while chunk 3 is listed");
+                }
+            });
+        });
+        assert_eq!(got, counts, "each point's reduction");
+        for i in 3 * CHUNK..n {
+            assert_eq!(pairs(nl, i), pairs(&whole, i), "point {i}, listed into recycled storage");
+        }
+        let (mut kept, mut built) = (HalfPairs::default(), HalfPairs::default());
+        nl.half_pairs(0..CHUNK, &mut kept);
+        whole.half_pairs(0..CHUNK, &mut built);
+        assert_eq!((kept.start, kept.entries), (built.start, built.entries), "chunk 0 keeps its pairs");
+        let query = std::panic::catch_unwind(|| nl.for_each(0, &pts, |_, _, _, _| ()));
+        assert!(query.is_err(), "chunk 0's payload was handed on");
+    }
 }
