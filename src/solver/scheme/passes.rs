@@ -267,11 +267,8 @@ impl<const D: usize> FluidPasses<D> {
         walls: Option<&'a WallSet<D>>,
     ) -> Sources<'a, D> {
         Sources {
-            h: fluid.h,
-            x: &fluid.x,
-            nl,
-            pts: self.points[..].into(),
             walls: walls.map(|ws| (ws, &self.wall_div[..], &self.wall_visc[..])),
+            ..Sources::fluid_only(fluid, nl, self.points[..].into())
         }
     }
 
