@@ -339,7 +339,12 @@ impl<const D: usize> IpstSlab<D> {
     /// The slab's share of one sweep: for its particles `particles` (whose sums `sums`
     /// it zeroes first), each fluid pair `j > i` once, added to both particles (to `j`'s
     /// spill if `j` is outside the slab), and each wall pair.
+    ///
+    /// Never inlined: built with `codegen-units = 1` or fat LTO, the compiler inlined it
+    /// into the stage closure of [`FluidPasses::ipst`], and a `ctvf`+`ipst` step ran 8-9 %
+    /// slower (docs/throughput.md, session 43).
     #[allow(clippy::too_many_arguments)]
+    #[inline(never)]
     fn sweep(
         &mut self,
         particles: std::ops::Range<usize>,
