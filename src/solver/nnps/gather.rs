@@ -58,7 +58,9 @@ impl<'a, T> Gather<'a, T> {
     /// Element `j`.
     #[inline(always)]
     pub fn get(&self, j: usize) -> &'a T {
-        assert!(j < self.len, "element {j} of {}", self.len);
+        if j >= self.len {
+            out_of_bounds(j, self.len)
+        }
         // SAFETY: in bounds (checked).
         unsafe { self.get_unchecked(j) }
     }
@@ -73,4 +75,13 @@ impl<'a, T> Gather<'a, T> {
         // constructor's).
         unsafe { &*self.ptr.add(j) }
     }
+}
+
+/// The panic of [`Gather::get`], out of line so that the loops do not keep its arguments in
+/// memory.
+#[cold]
+#[inline(never)]
+#[track_caller]
+fn out_of_bounds(j: usize, len: usize) -> ! {
+    panic!("element {j} of {len}")
 }
