@@ -57,6 +57,8 @@ impl<P> Listed<'_, P> {
 #[derive(Clone, Debug, Default)]
 pub struct HalfPairs {
     first: usize,
+    /// The points of the list the pairs were taken from: every `j` is below.
+    sources: usize,
     start: Vec<u32>,
     entries: Vec<u32>,
 }
@@ -79,6 +81,22 @@ impl HalfPairs {
     #[inline(always)]
     pub fn neighbours(&self, span: std::ops::Range<usize>) -> impl Iterator<Item = u32> + '_ {
         self.entries[span].iter().map(|&e| e & J_MASK)
+    }
+
+    /// The neighbours `j` of the pairs of `span`, each with `values[j]`. Checked once for
+    /// all of them, not for each (in IPST's sweeps the check took a compare and a branch a
+    /// pair).
+    #[inline(always)]
+    pub fn neighbours_with<'a, T>(
+        &'a self,
+        span: std::ops::Range<usize>,
+        values: &'a [T],
+    ) -> impl Iterator<Item = (u32, &'a T)> + 'a {
+        assert!(values.len() >= self.sources, "a value for each point the list was built from");
+        // SAFETY: every j < self.sources (see the field) <= values.len().
+        self.entries[span]
+            .iter()
+            .map(move |&e| (e & J_MASK, unsafe { values.get_unchecked((e & J_MASK) as usize) }))
     }
 
     /// The packed entries of point `i`'s pairs `j > i`.
@@ -436,8 +454,12 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let entries = half.entries(i);
         let n = entries.len();
         let shifts = self.shift_table();
+        assert!(points.len() >= self.sources, "a position for each point the list was built from");
         for (&e, xij) in entries.iter().zip(&mut xij[..n]) {
-            *xij = Self::pair(shifts, e, xi, points).1;
+            // SAFETY: j < self.sources (see the field) <= points.len(). Unchecked: in IPST's
+            // sweeps the check of each pair took two of its thirteen instructions.
+            let xj = unsafe { points.get_unchecked((e & J_MASK) as usize) };
+            *xij = Self::difference(shifts, e, xi, xj);
         }
         n
     }
@@ -447,6 +469,7 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
     /// over the pairs several times (the list is then filtered once).
     pub fn half_pairs(&self, points: std::ops::Range<usize>, half: &mut HalfPairs) {
         half.first = points.start;
+        half.sources = self.sources;
         half.start.clear();
         half.entries.clear();
         for i in points {

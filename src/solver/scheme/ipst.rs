@@ -369,10 +369,9 @@ impl<const D: usize> IpstSlab<D> {
                 let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
                 let (pair_x, pair_fw) = (&p.xij[fluid.clone()], &p.fw[fluid]);
                 let span = self.half.span(i);
-                let pair_j = self.half.neighbours(span);
+                let pair_j = self.half.neighbours_with(span, vol);
                 let pairs = pair_x.iter().zip(pair_fw).zip(pair_j);
-                for ((&xij, &(f, w)), j) in pairs {
-                    let v_j = vol[j as usize];
+                for ((&xij, &(f, w)), (j, &v_j)) in pairs {
                     d += xij * (f * v_j);
                     chi += w;
                     // x_ji = -x_ij
