@@ -367,11 +367,11 @@ impl<const D: usize> IpstSlab<D> {
                 let (fluid, wall) = p.ranges(l);
                 let v_i = vol[i];
                 let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
-                let (pair_x, pair_fw) = (&p.xij[fluid.clone()], &p.fw[fluid]);
+                let (pair_x, pair_f, pair_w) = (&p.xij[fluid.clone()], &p.f[fluid.clone()], &p.chi[fluid]);
                 let span = self.half.span(i);
                 let pair_j = self.half.neighbours_with(span, vol);
-                let pairs = pair_x.iter().zip(pair_fw).zip(pair_j);
-                for ((&xij, &(f, w)), (j, &v_j)) in pairs {
+                let pairs = pair_x.iter().zip(pair_f.iter().zip(pair_w)).zip(pair_j);
+                for ((&xij, (&f, &w)), (j, &v_j)) in pairs {
                     d += xij * (f * v_j);
                     chi += w;
                     // x_ji = -x_ij
@@ -385,7 +385,7 @@ impl<const D: usize> IpstSlab<D> {
                     }
                 }
                 for q in wall {
-                    let (f, w) = p.fw[q];
+                    let (f, w) = (p.f[q], p.chi[q]);
                     d += p.xij[q] * (f * p.vol[q]);
                     chi += w;
                 }
@@ -413,8 +413,10 @@ struct IpstPairs<const D: usize> {
     /// The wall neighbours' volumes (at the wall pairs' slots; the fluid neighbours' are
     /// read from the particles' array).
     vol: Vec<f64>,
-    /// `W_ab / r_ab` (eq. 37) and `h^2 W_ab` (eq. 40).
-    fw: Vec<(f64, f64)>,
+    /// `W_ab / r_ab` (eq. 37).
+    f: Vec<f64>,
+    /// `h^2 W_ab` (eq. 40).
+    chi: Vec<f64>,
 }
 
 impl<const D: usize> IpstPairs<D> {
@@ -440,7 +442,8 @@ impl<const D: usize> IpstPairs<D> {
             let grown = (room + room / 4).next_multiple_of(LANES);
             self.xij.resize(grown, Vector::zeros());
             self.vol.resize(grown, 0.0);
-            self.fw.resize(grown, (0.0, 0.0));
+            self.f.resize(grown, 0.0);
+            self.chi.resize(grown, 0.0);
         }
         self.fluid_end.clear();
         self.end.clear();
@@ -458,7 +461,7 @@ impl<const D: usize> IpstPairs<D> {
         }
         k.map_batch(
             &self.xij[..room],
-            &mut self.fw[..room],
+            (&mut self.f[..room], &mut self.chi[..room]),
             |xij| xij.norm_squared().sqrt(),
             |r, w| (shifting::ipst_factor(w, r), shifting::ipst_chi(k.h, w)),
         );
