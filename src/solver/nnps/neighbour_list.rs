@@ -70,17 +70,11 @@ impl HalfPairs {
     }
 
     /// Where point `i`'s pairs `j > i` sit among all the pairs of the run (in the order of
-    /// [`neighbours`](Self::neighbours)).
+    /// [`neighbours_with`](Self::neighbours_with)).
     #[inline(always)]
     pub fn span(&self, i: usize) -> std::ops::Range<usize> {
         let l = i - self.first;
         self.start[l] as usize..self.start[l + 1] as usize
-    }
-
-    /// The neighbours `j` of the pairs of `span`.
-    #[inline(always)]
-    pub fn neighbours(&self, span: std::ops::Range<usize>) -> impl Iterator<Item = u32> + '_ {
-        self.entries[span].iter().map(|&e| e & J_MASK)
     }
 
     /// The neighbours `j` of the pairs of `span`, each with `values[j]`. Checked once for
@@ -387,21 +381,8 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         (chunk, chunk.start[l] as usize..chunk.start[l + 1] as usize)
     }
 
-    /// The neighbour of entry `e` and its difference `x_ij` from a query at `xi`, through
-    /// the entry's periodic image (the one formula every pass uses, so that all see the
-    /// same bits).
-    #[inline(always)]
-    fn pair(
-        shifts: &[Vector<D>; CODES],
-        e: u32,
-        xi: Vector<D>,
-        points: Gather<'_, Vector<D>>,
-    ) -> (usize, Vector<D>) {
-        let j = (e & J_MASK) as usize;
-        (j, Self::difference(shifts, e, xi, points.get(j)))
-    }
-
-    /// `x_ij` of entry `e` for a query at `xi` and a neighbour at `xj`.
+    /// `x_ij` of entry `e` for a query at `xi` and a neighbour at `xj`, through the entry's
+    /// periodic image (the one formula every pass uses, so that all see the same bits).
     #[inline(always)]
     fn difference(shifts: &[Vector<D>; CODES], e: u32, xi: Vector<D>, xj: &Vector<D>) -> Vector<D> {
         (xi - shifts[(e >> J_BITS) as usize]) - *xj
@@ -430,17 +411,23 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         let (chunk, range) = self.range(i);
         let entries = &chunk.entries[range];
         let n = entries.len();
-        let (shifts, points) = (self.shift_table(), points.into());
+        let shifts = self.shift_table();
+        assert!(
+            points.len() >= self.sources && values.len() >= self.sources,
+            "a position and a value for each point the list was built from"
+        );
         for ((&e, xij), value) in entries.iter().zip(&mut out.xij[..n]).zip(&mut out.value[..n]) {
-            let j;
-            (j, *xij) = Self::pair(shifts, e, xi, points);
-            *value = values[j];
+            let j = (e & J_MASK) as usize;
+            // SAFETY: j < self.sources (see the field) <= both lengths. Checked once a point,
+            // as in `write_half_pairs`.
+            let (xj, v) = unsafe { (points.get_unchecked(j), values.get_unchecked(j)) };
+            (*xij, *value) = (Self::difference(shifts, e, xi, xj), *v);
         }
     }
 
     /// As [`write_pairs`](Self::write_pairs) over the pairs `j > i` of point `i` listed in
     /// `half` (by [`half_pairs`](Self::half_pairs)), the differences `x_ij` only (the
-    /// neighbours are [`HalfPairs::neighbours`]).
+    /// neighbours are [`HalfPairs::neighbours_with`]).
     /// Returns how many were written.
     #[inline(always)]
     pub fn write_half_pairs(
@@ -717,10 +704,11 @@ mod tests {
                 let mut expected = Vec::new();
                 nl.for_each(i, &pts, |j, x, _, _| {
                     if j > i {
-                        expected.push((j as u32, x));
+                        expected.push((j as u32, pts[j], x));
                     }
                 });
-                let got: Vec<_> = half.neighbours(span).zip(xij[..m].iter().copied()).collect();
+                let pairs = half.neighbours_with(span, &pts).zip(&xij[..m]);
+                let got: Vec<_> = pairs.map(|((j, &xj), &x)| (j, xj, x)).collect();
                 assert_eq!(got, expected, "point {i}");
             }
         }
