@@ -247,23 +247,21 @@ impl ScaledKernel {
         })
     }
 
-    /// `(out.0[k], out.1[k]) = f(r, W(r))` at the distance `r = distance(&items[k])` of each
-    /// item: one loop the compiler vectorises for callers that need two values of a pair
-    /// (the kernel's match is outside it). Two arrays rather than one of pairs: IPST's
-    /// sweeps ran 1-2 % faster without the interleaving stores (docs/throughput.md,
-    /// session 44).
+    /// `out[k] = f(r, W(r))` at the distance `r = distance(&items[k])` of each item: one
+    /// loop the compiler vectorises for callers that need a value of each pair (the
+    /// kernel's match is outside it).
     #[inline(always)]
-    pub fn map_batch<X, A, B>(
+    pub fn map_batch<X, A>(
         &self,
         items: &[X],
-        out: (&mut [A], &mut [B]),
+        out: &mut [A],
         distance: impl Fn(&X) -> f64,
-        f: impl Fn(f64, f64) -> (A, B),
+        f: impl Fn(f64, f64) -> A,
     ) {
         with_shape!(self.kernel.kind, shape => {
-            for ((a, b), x) in out.0.iter_mut().zip(out.1.iter_mut()).zip(items) {
+            for (a, x) in out.iter_mut().zip(items) {
                 let r = distance(x);
-                (*a, *b) = f(r, self.fac * shape(r * self.inv_h).0);
+                *a = f(r, self.fac * shape(r * self.inv_h).0);
             }
         })
     }
@@ -377,14 +375,14 @@ mod tests {
             let r2: Vec<f64> = (0..1000).map(|i| (i as f64 * 1.1e-4).powi(2)).collect();
             let mut both = vec![(0.0, 0.0); r2.len()];
             let mut w = vec![0.0; r2.len()];
-            let (mut r, mut mapped) = (vec![0.0; r2.len()], vec![0.0; r2.len()]);
+            let mut mapped = vec![(0.0, 0.0); r2.len()];
             k.w_and_grad_factor_batch(&r2, &mut both);
             k.w_batch(&r2, &mut w);
-            k.map_batch(&r2, (&mut r, &mut mapped), |r2| r2.sqrt(), |r, w| (r, w));
+            k.map_batch(&r2, &mut mapped, |r2| r2.sqrt(), |r, w| (r, w));
             for (i, &r2) in r2.iter().enumerate() {
                 assert_eq!(both[i], k.w_and_grad_factor(r2.sqrt()), "{kind:?} at r2 = {r2}");
                 assert_eq!(w[i], k.w(r2.sqrt()));
-                assert_eq!((r[i], mapped[i]), (r2.sqrt(), w[i]));
+                assert_eq!(mapped[i], (r2.sqrt(), w[i]));
             }
         }
     }

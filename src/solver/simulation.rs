@@ -207,8 +207,13 @@ impl<const D: usize> Simulation<D> {
         let free_surface = scheme.free_surface.is_some();
         if let Some(t) = scheme.transport.as_mut() {
             if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
-                *chi_ref =
-                    ipst_chi_reference(&sim.state.fluid, &sim.neighbours, sim.walls.as_ref(), free_surface);
+                *chi_ref = ipst_chi_reference(
+                    &sim.state.fluid,
+                    &sim.neighbours,
+                    sim.walls.as_ref(),
+                    &sim.kernel,
+                    free_surface,
+                );
             }
         }
         sim.state.scheme = scheme;

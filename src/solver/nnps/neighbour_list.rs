@@ -369,6 +369,28 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
+    /// Calls `f(j, x_ij)` for every neighbour `j` of query point `i` at `xi` (itself
+    /// included), as [`for_each_from`](Self::for_each_from) visits them, without their
+    /// payloads (which the list may have handed on: `recycle`).
+    #[inline(always)]
+    pub fn for_each_difference<F: FnMut(usize, Vector<D>)>(
+        &self,
+        i: usize,
+        xi: Vector<D>,
+        points: &[Vector<D>],
+        mut f: F,
+    ) {
+        assert!(points.len() >= self.sources, "a position for each point the list was built from");
+        let (chunk, range) = self.range(i);
+        let shifts = self.shift_table();
+        for &e in &chunk.entries[range] {
+            let j = (e & J_MASK) as usize;
+            // SAFETY: j < self.sources (see the field) <= points.len().
+            let xj = unsafe { points.get_unchecked(j) };
+            f(j, Self::difference(shifts, e, xi, xj));
+        }
+    }
+
     /// The chunk holding point `i` and the range of its entries in it. The chunk alone is
     /// borrowed, not the array of all (which a [`ChunkWriter`] may be filling elsewhere).
     #[inline(always)]

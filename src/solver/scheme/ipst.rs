@@ -11,7 +11,7 @@
 //! each loop lost some 20 microseconds to its join, and the moves took 1.5x their one-thread
 //! time, about a tenth of IPST's time in all (docs/throughput.md, session 40).
 
-use super::passes::{FluidPasses, KernelList, PairKernel, MIN_LEN};
+use super::passes::{FluidPasses, KernelList, MIN_LEN};
 use super::stages::{run_stages, Board, Grid, Tiled};
 use super::{FluidScheme, Shifting, SurfaceFields, WallSet};
 use crate::solver::equations::{free_surface, shifting};
@@ -32,13 +32,14 @@ pub(super) struct IpstWork<const D: usize> {
     x: [Vec<Vector<D>>; 2],
     slabs: Slabs,
     slab_work: Vec<Mutex<IpstSlab<D>>>,
-    /// Each particle's sums, `(sum V_b n_ab W_ab, sum h^2 W_ab)`.
-    sums: Vec<(Vector<D>, f64)>,
+    /// Each particle's sum `sum V_b n_ab W_ab`.
+    sums: Vec<Vector<D>>,
     /// The fluid's and the walls' volumes, as compact arrays.
     vol: Vec<f64>,
     wall_vol: Vec<f64>,
     /// Which sweeps and moves are done on each slab.
     board: SweepBoard,
+    witness: Mutex<Witness>,
 }
 
 impl<const D: usize> FluidPasses<D> {
@@ -56,8 +57,9 @@ impl<const D: usize> FluidPasses<D> {
     /// value is of the fifth order in the distance they moved in (quintic spline).
     /// Each fluid pair is evaluated once a sweep and adds to both particles (`W_ab` and
     /// `r_ab` are symmetric, `x_ba = -x_ab`), in the slabs of `cells` (see [`Slabs`]), so
-    /// that the sums do not depend on the thread count. `cells` must have binned the fluid
-    /// in its current order. Returns the number of moves made.
+    /// that the sums do not depend on the thread count. chi is not summed in the sweeps:
+    /// the moves evaluate it, for a witness first ([`Witness`]). `cells` must have binned
+    /// the fluid in its current order. Returns the number of moves made.
     #[allow(clippy::too_many_arguments)]
     pub fn ipst(
         &mut self,
@@ -88,7 +90,7 @@ impl<const D: usize> FluidPasses<D> {
         x0.clear();
         x0.extend_from_slice(&fluid.x);
         x1.resize(n, Vector::zeros());
-        w.sums.resize(n, (Vector::zeros(), 0.0));
+        w.sums.resize(n, Vector::zeros());
         // The volumes gathered by `accelerations` at these positions, as compact arrays
         // (the sweeps read nothing else of the neighbours).
         w.vol.resize(n, 0.0);
@@ -103,11 +105,14 @@ impl<const D: usize> FluidPasses<D> {
             let slab = slab.get_mut().unwrap_or_else(PoisonError::into_inner);
             nl.half_pairs(slabs.range(t), &mut slab.half);
         });
-        // A particle's own share of chi (its pair with itself is not in the half list).
-        let chi_self = shifting::ipst_chi(k.h, k.w(0.0));
         let walls = walls.map(|ws| (ws, &wall_vol[..]));
         let test = Convergence { chi_ref, tol };
         let mut board = std::mem::take(&mut w.board);
+        let witness = w.witness.get_mut().unwrap_or_else(PoisonError::into_inner);
+        (witness.failed, witness.found) = (None, None);
+        // (A body that lost particles since.)
+        witness.i = witness.i.min(n.saturating_sub(1));
+        let witness = &w.witness;
         board.reset(slabs.bounds(), rayon::current_num_threads().min(slabs.len()), max_iter, test);
 
         // Sweep m reads the positions x[m % 2] and writes each slab's sums and spills; the
@@ -122,6 +127,9 @@ impl<const D: usize> FluidPasses<D> {
         //   (and of the first slab, if t is the last) read: it waits for the sweeps m of
         //   t - 1..=t + 1, which waited for the moves m - 1 around them, which waited for the
         //   sweeps m - 1 around those.
+        // - moves m also read x[m % 2] around their slab, for chi (eq. 40): no stage writes it
+        //   between the test of sweep m - 1, which waits for every move m - 1, and that of
+        //   sweep m, which every move m + 1 waits for.
         // The spills are behind a mutex each, uncontended: a slab's spills are read by the
         // moves of the slabs next to it before its next sweep, which waits for them.
         let x = [Tiled::new(x0), Tiled::new(x1)];
@@ -136,7 +144,7 @@ impl<const D: usize> FluidPasses<D> {
             let sums = unsafe { sums.run(range.clone()) };
             if !task.moves {
                 let xs = unsafe { x[m % 2].gather() };
-                lock(t).sweep(range, sums, xs, nl, vol, walls, &k, chi_self);
+                lock(t).sweep(range, sums, xs, nl, vol, walls, &k);
                 f64::MIN
             } else {
                 for source in slabs.spill_sources(t) {
@@ -144,7 +152,10 @@ impl<const D: usize> FluidPasses<D> {
                 }
                 let from = unsafe { x[m % 2].read(range.clone()) };
                 let to = unsafe { x[(m + 1) % 2].run(range.clone()) };
-                move_slab(range, sums, from, to, surface, u_max * dt)
+                move_slab(range.clone(), sums, from, to, surface, u_max * dt);
+                let xs = unsafe { x[m % 2].read(0..n) };
+                let chi = |i: usize| chi_at(i, xs, nl, walls.map(|(ws, _)| ws), &k);
+                Witness::bound(witness, task.sweep, range, chi, &test)
             }
         };
         let board = run_stages(board, &run);
@@ -160,27 +171,25 @@ impl<const D: usize> FluidPasses<D> {
 }
 
 /// Adds the shares `spill` set aside for particles from `first` on to their sums `sums`.
-fn add_spill<const D: usize>(spill: &[(u32, Vector<D>, f64)], first: usize, sums: &mut [(Vector<D>, f64)]) {
-    for &(j, d, chi) in spill {
+fn add_spill<const D: usize>(spill: &[(u32, Vector<D>)], first: usize, sums: &mut [Vector<D>]) {
+    for &(j, d) in spill {
         if let Some(sum) = (j as usize).checked_sub(first).and_then(|l| sums.get_mut(l)) {
-            sum.0 += d;
-            sum.1 += chi;
+            *sum += d;
         }
     }
 }
 
 /// Moves the particles `range` from `xs` to `next` by `scale` times their sums (eq. 37),
-/// adjusted at a free surface (eq. 45); returns their largest chi.
+/// adjusted at a free surface (eq. 45).
 fn move_slab<const D: usize>(
     range: Range<usize>,
-    sums: &[(Vector<D>, f64)],
+    sums: &[Vector<D>],
     xs: &[Vector<D>],
     next: &mut [Vector<D>],
     surface: Option<&SurfaceFields<D>>,
     scale: f64,
-) -> f64 {
-    let mut chi_max = f64::MIN;
-    for (((i, &(d, chi)), next), &x) in range.zip(sums).zip(next).zip(xs) {
+) {
+    for (((i, &d), next), &x) in range.zip(sums).zip(next).zip(xs) {
         let mut dr = d * scale;
         if let Some(fs) = surface {
             // eq. (45)
@@ -188,9 +197,81 @@ fn move_slab<const D: usize>(
         }
         // Not wrapped: the list's image shifts refer to the unwrapped positions.
         *next = x + dr;
-        chi_max = chi_max.max(chi);
     }
-    chi_max
+}
+
+/// chi of eq. (40) of particle `i` at positions `xs`: `h^2 sum_b W_ab` over its fluid
+/// neighbours (itself included) in the order of the list, then over the walls.
+fn chi_at<const D: usize>(
+    i: usize,
+    xs: &[Vector<D>],
+    nl: &KernelList<D>,
+    walls: Option<&WallSet<D>>,
+    k: &ScaledKernel,
+) -> f64 {
+    let mut chi = 0.0;
+    let mut add = |_, xij: Vector<D>| chi += shifting::ipst_chi(k.h, k.w(xij.norm_squared().sqrt()));
+    nl.for_each_difference(i, xs[i], xs, &mut add);
+    if let Some(ws) = walls {
+        ws.fluid_to_wall.for_each_difference(i, xs[i], &ws.wall.x, add);
+    }
+    chi
+}
+
+/// The particle whose chi a sweep's test (eq. 39) takes first: once the flow has developed,
+/// a particle whose chi is above the bound stays above it from move to move, and its chi
+/// alone fails the test (the largest chi of all is then above it too). The sweeps then
+/// need not sum chi for every particle, which took about 5 % of their time
+/// (docs/throughput.md, session 51). The test's outcome is the same as on every chi;
+/// which slabs find the witness's chi first, and so sum their own, may depend on the
+/// threads' timing, and changes nothing but the time.
+#[derive(Debug, Default)]
+struct Witness {
+    /// The particle with the largest chi found last.
+    i: usize,
+    /// The sweep of this step whose test the witness's chi failed.
+    failed: Option<u32>,
+    /// The sweep of this step whose slabs' largest chi was last summed, and the largest.
+    found: Option<(u32, f64)>,
+}
+
+impl Witness {
+    /// What the test of sweep `sweep` needs of the chi (`chi(i)` of particle `i`) of the
+    /// slab `range`, at the positions the sweep started from: nothing (`f64::MIN`) if the
+    /// test has failed on the witness, the witness's chi if it fails the test, else the
+    /// slab's largest chi, whose particle becomes the witness if no slab's was larger.
+    fn bound(
+        me: &Mutex<Self>,
+        sweep: u32,
+        range: Range<usize>,
+        chi: impl Fn(usize) -> f64,
+        test: &Convergence,
+    ) -> f64 {
+        let lock = || me.lock().unwrap_or_else(PoisonError::into_inner);
+        {
+            let mut w = lock();
+            if w.failed == Some(sweep) || range.is_empty() {
+                return f64::MIN;
+            }
+            let c = chi(w.i);
+            if test.exceeded(c) {
+                w.failed = Some(sweep);
+                return c;
+            }
+        }
+        let (mut arg, mut max) = (range.start, f64::MIN);
+        for i in range {
+            let c = chi(i);
+            if c > max {
+                (arg, max) = (i, c);
+            }
+        }
+        let mut w = lock();
+        if !matches!(w.found, Some((s, larger)) if s == sweep && larger >= max) {
+            (w.i, w.found) = (arg, Some((sweep, max)));
+        }
+        max
+    }
 }
 
 /// A stage of IPST on a slab: sweep `sweep` (the sums at the positions it starts from), or
@@ -213,6 +294,13 @@ impl Convergence {
     fn met(&self, chi_max: f64) -> bool {
         (chi_max - self.chi_ref).abs() <= self.tol * self.chi_ref
     }
+
+    /// Whether `chi`, the chi of some particle, fails the test for the largest chi too:
+    /// it is above the bound, and (the rounded difference being monotone) so is any
+    /// larger chi.
+    fn exceeded(&self, chi: f64) -> bool {
+        chi - self.chi_ref > self.tol * self.chi_ref
+    }
 }
 
 /// What the workers of IPST's sweeps share: on each slab, the stages done and taken, a
@@ -220,7 +308,8 @@ impl Convergence {
 /// moves. A sweep's moves on a slab wait for its sweep on the slab and both next to it (whose
 /// pairs reach it), a sweep for the moves before it on the slab and both next to it (whose
 /// positions it reads), and moves for the test of the sweep before: the test needs every
-/// slab's chi, and once it is met, the positions it was met at stay as they are.
+/// slab's chi (or a witness's, [`Witness`]), and once it is met, the positions it was met
+/// at stay as they are.
 /// Each worker takes its region's earliest stage that is ready, so that on one thread the
 /// sweeps run one after the other as in a loop.
 #[derive(Clone, Debug, Default)]
@@ -230,7 +319,7 @@ struct SweepBoard {
     stages: u32,
     /// Sweeps tested and not converged.
     tested: u32,
-    /// Slabs moved in sweep `tested`, and their largest chi.
+    /// Slabs moved in sweep `tested`, and the largest of what they returned of chi.
     moved: usize,
     chi_max: f64,
     test: Convergence,
@@ -264,7 +353,7 @@ fn pick(g: &Grid, slabs: Range<usize>, stages: u32, tested: u32) -> Option<usize
 
 impl Board for SweepBoard {
     type Task = SweepTask;
-    /// The largest chi of a slab's moves.
+    /// What the test needs of the chi of a slab's moves ([`Witness::bound`]).
     type Out = f64;
 
     fn grid(&mut self) -> &mut Grid {
@@ -280,7 +369,8 @@ impl Board for SweepBoard {
     fn finish(&mut self, task: SweepTask, chi_max: f64, _: f64) {
         self.grid.done[task.slab] += 1;
         if task.moves {
-            // The largest chi (max is exact: any grouping gives the same).
+            // The largest (max is exact: any grouping gives the same), which fails the test
+            // if a witness's chi did, and is the largest chi of all if none did.
             self.chi_max = self.chi_max.max(chi_max);
             self.moved += 1;
             if self.moved == self.grid.tiles() {
@@ -318,7 +408,7 @@ const IPST_GROUP: usize = 16;
 const LANES: usize = 8;
 
 /// One IPST slab's work space, kept from step to step: its pair arrays, and the shares of
-/// its pairs that belong to particles of other slabs, `(j, V_a W_ab x_ba / r, h^2 W_ab)`.
+/// its pairs that belong to particles of other slabs, `(j, V_a W_ab x_ba / r)`.
 #[derive(Clone, Debug, Default)]
 struct IpstSlab<const D: usize> {
     /// The slab's fluid pairs `j > i`, listed once a step. The sweeps read the neighbours'
@@ -332,7 +422,7 @@ struct IpstSlab<const D: usize> {
     /// evicting what a step left in the shared cache).
     half: HalfPairs,
     pairs: IpstPairs<D>,
-    spill: Vec<(u32, Vector<D>, f64)>,
+    spill: Vec<(u32, Vector<D>)>,
 }
 
 impl<const D: usize> IpstSlab<D> {
@@ -348,15 +438,14 @@ impl<const D: usize> IpstSlab<D> {
     fn sweep(
         &mut self,
         particles: std::ops::Range<usize>,
-        sums: &mut [(Vector<D>, f64)],
+        sums: &mut [Vector<D>],
         xs: Gather<'_, Vector<D>>,
         nl: &KernelList<D>,
         vol: &[f64],
         walls: Option<(&WallSet<D>, &[f64])>,
         k: &ScaledKernel,
-        chi_self: f64,
     ) {
-        sums.fill((Vector::zeros(), 0.0));
+        sums.fill(Vector::zeros());
         self.spill.clear();
         let first = particles.start;
         for group in particles.step_by(IPST_GROUP) {
@@ -366,32 +455,25 @@ impl<const D: usize> IpstSlab<D> {
             for (l, i) in group.enumerate() {
                 let (fluid, wall) = p.ranges(l);
                 let v_i = vol[i];
-                let (mut d, mut chi) = (Vector::<D>::zeros(), chi_self);
-                let (pair_x, pair_f, pair_w) = (&p.xij[fluid.clone()], &p.f[fluid.clone()], &p.chi[fluid]);
+                let mut d = Vector::<D>::zeros();
+                let (pair_x, pair_f) = (&p.xij[fluid.clone()], &p.f[fluid]);
                 let span = self.half.span(i);
                 let pair_j = self.half.neighbours_with(span, vol);
-                let pairs = pair_x.iter().zip(pair_f.iter().zip(pair_w)).zip(pair_j);
-                for ((&xij, (&f, &w)), (j, &v_j)) in pairs {
+                for ((&xij, &f), (j, &v_j)) in pair_x.iter().zip(pair_f).zip(pair_j) {
                     d += xij * (f * v_j);
-                    chi += w;
                     // x_ji = -x_ij
                     let share = xij * -(f * v_i);
                     let slot = j as usize - first;
                     if slot < sums.len() {
-                        sums[slot].0 += share;
-                        sums[slot].1 += w;
+                        sums[slot] += share;
                     } else {
-                        self.spill.push((j, share, w));
+                        self.spill.push((j, share));
                     }
                 }
                 for q in wall {
-                    let (f, w) = (p.f[q], p.chi[q]);
-                    d += p.xij[q] * (f * p.vol[q]);
-                    chi += w;
+                    d += p.xij[q] * (p.f[q] * p.vol[q]);
                 }
-                let sum = &mut sums[i - first];
-                sum.0 += d;
-                sum.1 += chi;
+                sums[i - first] += d;
             }
         }
         // Room for a quarter more shares set aside, so that later sweeps do not allocate.
@@ -401,7 +483,7 @@ impl<const D: usize> IpstSlab<D> {
 }
 
 /// The pairs of a group of particles at moved positions, as arrays (reused from group to
-/// group), for the IPST sums of eqs. (37) and (40): for each particle its fluid pairs
+/// group), for the IPST sum of eq. (37): for each particle its fluid pairs
 /// `j > i`, then its wall pairs. The distances, the kernel and the factors are evaluated
 /// for all the pairs at once in vectorised loops.
 #[derive(Clone, Debug, Default)]
@@ -415,8 +497,6 @@ struct IpstPairs<const D: usize> {
     vol: Vec<f64>,
     /// `W_ab / r_ab` (eq. 37).
     f: Vec<f64>,
-    /// `h^2 W_ab` (eq. 40).
-    chi: Vec<f64>,
 }
 
 impl<const D: usize> IpstPairs<D> {
@@ -443,7 +523,6 @@ impl<const D: usize> IpstPairs<D> {
             self.xij.resize(grown, Vector::zeros());
             self.vol.resize(grown, 0.0);
             self.f.resize(grown, 0.0);
-            self.chi.resize(grown, 0.0);
         }
         self.fluid_end.clear();
         self.end.clear();
@@ -461,9 +540,9 @@ impl<const D: usize> IpstPairs<D> {
         }
         k.map_batch(
             &self.xij[..room],
-            (&mut self.f[..room], &mut self.chi[..room]),
+            &mut self.f[..room],
             |xij| xij.norm_squared().sqrt(),
-            |r, w| (shifting::ipst_factor(w, r), shifting::ipst_chi(k.h, w)),
+            |r, w| shifting::ipst_factor(w, r),
         );
     }
 
@@ -483,19 +562,11 @@ pub fn ipst_chi_reference<const D: usize>(
     fluid: &Fluid<D>,
     nl: &KernelList<D>,
     walls: Option<&WallSet<D>>,
+    k: &Kernel,
     free_surface: bool,
 ) -> f64 {
-    let chi: Vec<f64> = (0..fluid.len())
-        .map(|i| {
-            let mut s = 0.0;
-            let mut add = |kw: &PairKernel| s += shifting::ipst_chi(fluid.h, kw.w);
-            nl.for_each(i, &fluid.x, |_, _, _, kw| add(kw));
-            if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, fluid.x[i], &ws.wall.x, |_, _, _, kw| add(kw));
-            }
-            s
-        })
-        .collect();
+    let k = k.scaled(fluid.h);
+    let chi: Vec<f64> = (0..fluid.len()).map(|i| chi_at(i, &fluid.x, nl, walls, &k)).collect();
     if free_surface {
         chi.iter().fold(f64::MIN, |m, &v| m.max(v))
     } else {
@@ -560,17 +631,13 @@ mod tests {
         }
     }
 
-    /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
-    /// slabs, equals the direct sum of every particle over its whole neighbour list (to
-    /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
-    /// bit for bit the same on one and on two threads.
-    #[test]
-    fn ipst_pairs_once_equal_the_direct_sum() {
+    /// A lattice of `n x n` particles in the periodic unit square, each moved by up to a
+    /// fifth of dx and of a mass up to a tenth off, binned and listed with the quintic
+    /// spline: several IPST slabs, with pairs across the periodic edges.
+    fn perturbed_lattice(n: usize) -> (Fluid<2>, CellList<2>, KernelList<2>, Kernel) {
         use crate::solver::kernel::KernelKind;
         use crate::solver::nnps::Domain;
         use crate::solver::particles::FluidInit;
-        // Under Miri (which checks the slabs' shared access), four slabs of 6 x 24.
-        let n = if cfg!(miri) { 24 } else { 128 };
         let dx = 1.0 / n as f64;
         let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
         let x: Vec<Vector<2>> = (0..n * n)
@@ -594,6 +661,18 @@ mod tests {
         cells.mark_reordered();
         let mut nl = KernelList::new();
         build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        (fluid, cells, nl, kernel)
+    }
+
+    /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
+    /// slabs, equals the direct sum of every particle over its whole neighbour list (to
+    /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
+    /// bit for bit the same on one and on two threads.
+    #[test]
+    fn ipst_pairs_once_equal_the_direct_sum() {
+        // Under Miri (which checks the slabs' shared access), four slabs of 6 x 24.
+        let (fluid, cells, nl, kernel) = perturbed_lattice(if cfg!(miri) { 24 } else { 128 });
+        let dx = fluid.h;
         let settings = FluidSettings {
             pst: Pst::Ipst,
             ipst_max_iter: 1,
@@ -636,5 +715,81 @@ mod tests {
             largest = largest.max(direct.norm());
         }
         assert!(largest > 1.0, "the perturbed lattice is shifted ({largest})");
+    }
+    /// IPST stops at the first sweep whose largest chi meets the test of eq. (39), as a
+    /// direct loop over every particle's whole list finds it: at once, after three moves,
+    /// or never (ten moves, where a witness's chi alone fails the test and the sweeps sum
+    /// no chi). The moves are those of the direct loop (to rounding), and bit for bit the
+    /// same on one and on two threads.
+    #[test]
+    fn ipst_stops_where_every_particles_chi_meets_the_test() {
+        let (fluid, cells, nl, kernel) = perturbed_lattice(if cfg!(miri) { 24 } else { 96 });
+        let (h, k) = (fluid.h, kernel.scaled(fluid.h));
+        let max_iter = 10;
+        let settings = FluidSettings {
+            pst: Pst::Ipst,
+            ipst_max_iter: max_iter,
+            ..super::super::tests::internal_flow_settings()
+        };
+        let chi_ref = ipst_chi_reference(&fluid, &nl, None, &kernel, false);
+        // The first move shifts particles by up to a ninth of dx, and chi's largest
+        // excess falls from 17 % to 3 % over the ten.
+        let dt = 0.005;
+        let u_max = settings.u_ref;
+        // The direct loop: eqs. (37) and (40) over each particle's whole list, every move.
+        let mut xs = vec![fluid.x.clone()];
+        let mut chi_max = Vec::new();
+        for _ in 0..max_iter {
+            let x = xs.last().unwrap();
+            let (mut next, mut largest) = (x.clone(), f64::MIN);
+            for (i, next) in next.iter_mut().enumerate() {
+                let (mut d, mut chi) = (Vector::<2>::zeros(), 0.0);
+                nl.for_each(i, x, |j, xij, r2, _| {
+                    let w = k.w(r2.sqrt());
+                    d += xij * (fluid.m[j] / fluid.rho[j] * shifting::ipst_factor(w, r2.sqrt()));
+                    chi += h * h * w;
+                });
+                *next += d * (u_max * dt);
+                largest = largest.max(chi);
+            }
+            chi_max.push(largest);
+            xs.push(next);
+        }
+        let off: Vec<f64> = chi_max.iter().map(|c| (c - chi_ref).abs() / chi_ref).collect();
+        assert!(off.windows(2).take(4).all(|e| e[1] < e[0]), "the moves even chi out: {off:?}");
+        let smallest = off.iter().cloned().fold(f64::MAX, f64::min);
+        for (tol, stop) in [(off[0] * 1.01, 0), ((off[2] + off[3]) / 2.0, 3), (smallest / 2.0, max_iter)] {
+            let mut scheme = SchemeName::Ctvf.fluid_scheme(&settings);
+            if let Some(Shifting::Ipst { tol: t, chi_ref: r, .. }) =
+                scheme.transport.as_mut().map(|t| &mut t.shifting)
+            {
+                (*t, *r) = (tol, chi_ref);
+            }
+            let run = |threads: usize| {
+                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+                pool.install(|| {
+                    let (mut passes, mut rates) =
+                        (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
+                    passes.accelerations(&fluid, &nl, None, None, &scheme, &mut rates, dt);
+                    let moves =
+                        passes.ipst(&fluid, &nl, &cells, None, None, &kernel, &scheme, &mut rates, dt, 0);
+                    (moves, rates.a_c)
+                })
+            };
+            let ((moves, one), (moves_two, two)) = (run(1), run(2));
+            assert_eq!((moves, moves_two), (stop, stop), "tol {tol}: chi off by {off:?}");
+            assert!(one
+                .iter()
+                .zip(&two)
+                .all(|(a, b)| a.iter().zip(b).all(|(a, b)| a.to_bits() == b.to_bits())));
+            for (i, a) in one.iter().enumerate() {
+                // eq. (41)
+                let direct = (xs[stop][i] - fluid.x[i]) * (2.0 / (dt * dt));
+                assert!(
+                    (a - direct).norm() <= 1e-9 * direct.norm().max(1e-3),
+                    "particle {i}: {a:?} vs {direct:?}"
+                );
+            }
+        }
     }
 }
