@@ -664,6 +664,24 @@ mod tests {
         (fluid, cells, nl, kernel)
     }
 
+    /// IPST of a step of `dt` with `scheme` on `threads` threads, for the particles,
+    /// cells, list and kernel of `lattice`: the moves made, `(du/dt)_c` and the slabs.
+    fn ipst_on(
+        threads: usize,
+        (fluid, cells, nl, kernel): (&Fluid<2>, &CellList<2>, &KernelList<2>, &Kernel),
+        scheme: &FluidScheme,
+        dt: f64,
+    ) -> (usize, Vec<Vector<2>>, usize) {
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+        pool.install(|| {
+            let (mut passes, mut rates) =
+                (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
+            passes.accelerations(fluid, nl, None, None, scheme, &mut rates, dt);
+            let moves = passes.ipst(fluid, nl, cells, None, None, kernel, scheme, &mut rates, dt, 0);
+            (moves, rates.a_c, passes.ipst.slabs.len())
+        })
+    }
+
     /// One IPST move (eq. 37), each fluid pair evaluated once and added to both particles in
     /// slabs, equals the direct sum of every particle over its whole neighbour list (to
     /// rounding), on a lattice of several slabs with pairs across the periodic edges, and is
@@ -684,14 +702,8 @@ mod tests {
         };
         let dt = 1e-3;
         let a_c = |threads: usize| {
-            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-            pool.install(|| {
-                let (mut passes, mut rates) =
-                    (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
-                passes.accelerations(&fluid, &nl, None, None, &scheme, &mut rates, dt);
-                passes.ipst(&fluid, &nl, &cells, None, None, &kernel, &scheme, &mut rates, dt, 0);
-                (rates.a_c, passes.ipst.slabs.len())
-            })
+            let (_, a_c, slabs) = ipst_on(threads, (&fluid, &cells, &nl, &kernel), &scheme, dt);
+            (a_c, slabs)
         };
         let ((one, slabs), (two, _)) = (a_c(1), a_c(2));
         assert!(slabs >= 3, "{slabs} slabs");
@@ -766,15 +778,8 @@ mod tests {
                 (*t, *r) = (tol, chi_ref);
             }
             let run = |threads: usize| {
-                let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
-                pool.install(|| {
-                    let (mut passes, mut rates) =
-                        (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
-                    passes.accelerations(&fluid, &nl, None, None, &scheme, &mut rates, dt);
-                    let moves =
-                        passes.ipst(&fluid, &nl, &cells, None, None, &kernel, &scheme, &mut rates, dt, 0);
-                    (moves, rates.a_c)
-                })
+                let (moves, a_c, _) = ipst_on(threads, (&fluid, &cells, &nl, &kernel), &scheme, dt);
+                (moves, a_c)
             };
             let ((moves, one), (moves_two, two)) = (run(1), run(2));
             assert_eq!((moves, moves_two), (stop, stop), "tol {tol}: chi off by {off:?}");
