@@ -223,9 +223,8 @@ fn chi_at<const D: usize>(
 /// alone fails the test (the largest chi of all is then above it too). The sweeps then
 /// need not sum chi for every particle: without it IPST took 10-19 % less time on the
 /// Intel model 207 host (docs/throughput.md, session 51). The test's outcome is the same
-/// as on every chi;
-/// which slabs find the witness's chi first, and so sum their own, may depend on the
-/// threads' timing, and changes nothing but the time.
+/// as on every chi; which slabs find the witness's chi first, and so sum their own, may
+/// depend on the threads' timing, and changes nothing but the time.
 #[derive(Debug, Default)]
 struct Witness {
     /// The particle with the largest chi found last.
