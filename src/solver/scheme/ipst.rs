@@ -728,6 +728,7 @@ mod tests {
         }
         assert!(largest > 1.0, "the perturbed lattice is shifted ({largest})");
     }
+
     /// IPST stops at the first sweep whose largest chi meets the test of eq. (39), as a
     /// direct loop over every particle's whole list finds it: at once, after three moves,
     /// or never (ten moves, where a witness's chi alone fails the test and the sweeps sum
