@@ -5,9 +5,9 @@
 //!
 //! - `edac` at nx = 50: at least 10x the peer (PySPH), at an L1 error no worse;
 //! - `edac` at nx = 200 and 400: at least 15x the peer's nx = 50 run (the figure to
-//!   beat, the target as the project reads it since session 52: the one peer figure,
-//!   15 times which is its own prototype's 2.4 M), and, measured beside it as the stricter
-//!   reading, 15x the peer at the same size;
+//!   beat: its only peer figure, and 15 times it is about its own Rust prototype's 2.4 M;
+//!   the target as read since session 52), and, beside it, the stricter reading, 15x the
+//!   peer at the same size;
 //! - the cost of a particle-step flat from nx = 50 to 400 (O(N));
 //! - two threads at least 1.7x one at nx >= 100;
 //! - `ctvf`+`ipst` within 3x the cost of `edac` a step.
