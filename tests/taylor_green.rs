@@ -214,7 +214,7 @@ fn ipst_runs_on_every_interval_th_step_only() {
             // The accelerations just evaluated are for the next step, whose index is the
             // number of steps made.
             let due = sim.steps().is_multiple_of(interval);
-            let shifted = sim.state.rates.a_c.iter().any(|a| a.norm() > 0.0);
+            let shifted = sim.fluid_rates().a_c.iter().any(|a| a.norm() > 0.0);
             assert_eq!(sim.last_ipst_iterations(), if due { 3 } else { 0 }, "interval {interval}");
             assert_eq!(shifted, due, "interval {interval}, step {}", sim.steps());
         }

@@ -5,9 +5,9 @@
 use sphrepro::solver::kernel::{Kernel, KernelKind};
 use sphrepro::solver::math::Vector;
 use sphrepro::solver::nnps::Domain;
-use sphrepro::solver::particles::{Fluid, FluidInit};
 use sphrepro::solver::scheme::{FluidSettings, Pst, SchemeName};
 use sphrepro::solver::simulation::{Simulation, TimeSettings};
+use sphrepro::solver::systems::{Fluid, FluidInit};
 
 #[test]
 fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
@@ -36,10 +36,10 @@ fn a_periodic_cube_at_rest_stays_at_rest_in_3d() {
         let settings =
             FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
         let s = scheme.fluid_scheme(&settings);
-        let fluid = Fluid::new("fluid", dx, init.clone(), s.transport.is_some()).unwrap();
-        let time = TimeSettings::new(0.25, 10.0, 1.0);
+        let fluid = Fluid::new("fluid", dx, init.clone(), s).unwrap();
+        let domain = Domain::periodic([0.0; 3], [1.0; 3]);
         let mut sim =
-            Simulation::new(Domain::periodic([0.0; 3], [1.0; 3]), kernel, fluid, None, s, time).unwrap();
+            Simulation::builder(domain, kernel).body(fluid).time(TimeSettings::new(0.25)).build().unwrap();
         for _ in 0..20 {
             sim.step(f64::INFINITY).unwrap();
         }
@@ -94,10 +94,10 @@ fn taylor_green_in_a_box_starts_with_the_exact_acceleration() {
             }
             err / norm
         };
-        let e3 = rel(&sim3.fluid().x, &sim3.state.rates.du);
+        let e3 = rel(&sim3.fluid().x, &sim3.fluid_rates().du);
         let pad = |v: &[Vector<2>]| v.iter().map(|v| Vector::<3>::new(v[0], v[1], 0.0)).collect::<Vec<_>>();
-        let e2 = rel(&pad(&sim2.fluid().x), &pad(&sim2.state.rates.du));
-        let z = sim3.state.rates.du.iter().map(|a| a[2].abs()).fold(0.0, f64::max);
+        let e2 = rel(&pad(&sim2.fluid().x), &pad(&sim2.fluid_rates().du));
+        let z = sim3.fluid_rates().du.iter().map(|a| a[2].abs()).fold(0.0, f64::max);
         eprintln!("{scheme}: relative L1 error of du/dt at t = 0: 3D {e3:.4e}, 2D {e2:.4e}; largest |du_z/dt| {z:.2e}");
         assert!(e3 < 0.02, "{scheme}: {e3}");
         assert!((e3 / e2 - 1.0).abs() < 0.1, "{scheme}: 3D {e3} against 2D {e2}");

@@ -25,6 +25,21 @@ fn a_tank_at_rest_keeps_its_fluid_and_its_hydrostatic_pressure() {
     assert!(m["max_speed"] < 0.00082, "{m:?}");
 }
 
+/// A tank accelerated upward at a = g carries its fluid at rest in its own frame, with the
+/// hydrostatic pressure of g + a that the walls' extrapolation (eq. 52, with the wall's
+/// acceleration) gives it: its pressure error (against rho0 (g + a) (H - y)) and its
+/// spurious speed in the tank's frame stay within twice those of the same tank at rest.
+#[test]
+fn an_accelerated_tank_holds_the_hydrostatic_pressure_of_g_plus_a() {
+    let sets = ["dx=0.1", "tf=0.5"];
+    let rest = run(&hydrostatic_tank::ENTRY, &sets);
+    let moving = run(&hydrostatic_tank::ENTRY, &[sets[0], sets[1], "tank_acceleration=9.81"]);
+    assert_eq!(moving["particles_outside"], 0.0, "fluid crossed a wall");
+    for metric in ["pressure_rel_error", "max_speed"] {
+        assert!(moving[metric] <= 2.0 * rest[metric], "{metric}: {moving:?} against {rest:?} at rest");
+    }
+}
+
 #[test]
 fn the_cavity_at_re_100_approaches_ghia() {
     let m = run(&cavity::ENTRY, &["nx=30", "re=100", "tf=5.0", "pst=sun"]);

@@ -771,11 +771,11 @@ impl Expand<'_> {
             for p in combos {
                 let cname = case_name(g.name.as_deref(), &set_keys, &p)
                     .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
-                if let Some((key, why)) = scenes::common::unused_scheme_option(&p, given) {
+                if let Some(e) = scenes::common::unused_scheme_option(&p, given) {
                     return Err(loc.err(
                         gspan.clone(),
-                        key,
-                        format!("= {} in case `{cname}` {why}", p.0[key]),
+                        e.key,
+                        format!("= {} in case `{cname}` {}", p.0[e.key], e.why),
                     ));
                 }
                 if !valid_name(&cname) {

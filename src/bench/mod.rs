@@ -8,8 +8,8 @@
 pub mod targets;
 
 use crate::scenes::taylor_green;
+use crate::solver::schedule::warm;
 use crate::solver::simulation::{PhaseTimes, Schedule, Simulation};
-use crate::solver::warm;
 use serde::{Deserialize, Serialize};
 use std::time::Instant;
 

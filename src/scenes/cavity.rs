@@ -113,14 +113,18 @@ fn setup(p: &Params) -> Result<(f64, Kernel, f64, FluidScheme), String> {
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let (dx, kernel, h, scheme) = setup(p)?;
     let re = p.float("re");
-    let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
+    let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme, |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
     let wall = wall_from(&box_walls(L, L, dx, LAYERS, true), lid, dx, RHO0, C0)?
         .with_models(wall_density(p), wall_pressure(p));
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
-    let time = time_settings(p, C0, U);
-    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
+    let time = time_settings(p);
+    let sim = Simulation::builder(domain, kernel)
+        .body(fluid)
+        .body(wall)
+        .time(time)
+        .build()
         .map_err(|e| format!("scene `cavity`: {e}"))?;
     Ok(Box::new(Cavity {
         sim,

@@ -6,12 +6,12 @@ use crate::solver::integrator::{binding_limit, RatePositions, TimeStepLimit};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
-use crate::solver::particles::{Fluid, FluidInit, Wall, WallDensity, WallPressure};
 use crate::solver::scheme::{
-    paper, Corrections, DensityModel, FluidScheme, FluidSettings, PressureReference, Pst, SchemeName,
-    SurfacePressure,
+    paper, Corrections, DensityModel, FluidScheme, FluidSettings, OptionError, PressureReference, Pst,
+    SchemeName, SchemeOptions, SurfacePressure,
 };
 use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::systems::{Body, Fluid, FluidInit, Wall, WallDensity, WallPressure};
 use std::path::Path;
 
 const SWITCH: &[&str] = &["auto", "on", "off"];
@@ -75,12 +75,11 @@ pub fn free_surface_params() -> Vec<Spec> {
     )]
 }
 
-/// The time loop's settings from the common parameters (`cfl`, `rate_positions`), with the
-/// scene's speed of sound and reference speed.
-pub fn time_settings(p: &Params, c0: f64, u_ref: f64) -> TimeSettings {
+/// The time loop's settings from the common parameters (`cfl`, `rate_positions`).
+pub fn time_settings(p: &Params) -> TimeSettings {
     TimeSettings {
         rate_positions: RatePositions::from_name(p.str("rate_positions")).expect("checked choice"),
-        ..TimeSettings::new(p.float("cfl"), c0, u_ref)
+        ..TimeSettings::new(p.float("cfl"))
     }
 }
 
@@ -151,50 +150,36 @@ impl FluidConstants {
     }
 }
 
-/// A scheme option given for a scheme that does not read it, as `(key, why)`: particle
-/// shifting and the CTVF correction terms act in `ctvf` only (`edac` and `tvf` homogenise
-/// the particles with a background pressure), IPST's settings with `pst = ipst` only, and
-/// `edac_alpha` not in `tvf` (its pressure comes from the state equation). Such a value would
-/// be ignored without a word: a run asked for as "edac with IPST" would be plain `edac`.
-/// `given` says which keys were set (on the command line, or by a problem file); the values
-/// that switch an option off (`pst = none`, `corrections = none`, `corr_* = off`) pass.
-/// Scenes without scheme parameters pass.
-pub fn unused_scheme_option(p: &Params, given: impl Fn(&str) -> bool) -> Option<(&'static str, String)> {
+/// The scheme options of parameters `p` that were given (`given(key)`), typed for the
+/// solver's check ([`SchemeOptions::check`]) with the scheme and shifting asked for; `None`
+/// for a scene without scheme parameters. A value that switches an option off counts as
+/// given, and passes the check.
+pub fn scheme_options(p: &Params, given: impl Fn(&str) -> bool) -> Option<(SchemeName, Pst, SchemeOptions)> {
     let scheme = match p.0.get("scheme") {
-        Some(super::params::Value::Str(s)) => s.as_str(),
+        Some(super::params::Value::Str(s)) => SchemeName::from_name(s)?,
         _ => return None,
     };
-    let ctvf = scheme == "ctvf";
-    let not_ctvf = || {
-        format!(
-            "has no effect with `scheme` = {scheme}: particle shifting and the correction terms are ctvf's (edac and tvf homogenise with a background pressure)"
-        )
+    let pst = Pst::from_name(p.str("pst")).expect("checked choice");
+    let on = |key: &str| given(key).then(|| p.str(key) == "on");
+    let options = SchemeOptions {
+        pst: given("pst").then_some(pst),
+        corrections: given("corrections").then(|| p.str("corrections") == "all"),
+        corr_continuity: on("corr_continuity"),
+        corr_pressure: on("corr_pressure"),
+        corr_momentum: on("corr_momentum"),
+        ipst_tol: given("ipst_tol").then(|| p.float("ipst_tol")),
+        ipst_max_iter: given("ipst_max_iter").then(|| p.int("ipst_max_iter") as usize),
+        ipst_interval: given("ipst_interval").then(|| p.int("ipst_interval") as usize),
+        edac_alpha: given("edac_alpha").then(|| p.float("edac_alpha")),
     };
-    let off = |key: &str| match key {
-        "pst" | "corrections" => p.str(key) == "none",
-        _ => p.str(key) != "on",
-    };
-    for key in ["pst", "corrections", "corr_continuity", "corr_pressure", "corr_momentum"] {
-        if !ctvf && given(key) && !off(key) {
-            return Some((key, not_ctvf()));
-        }
-    }
-    for key in ["ipst_tol", "ipst_max_iter", "ipst_interval"] {
-        if given(key) && !(ctvf && p.str("pst") == "ipst") {
-            let why = if ctvf { format!("`pst` = {}", p.str("pst")) } else { format!("`scheme` = {scheme}") };
-            return Some((
-                key,
-                format!("has no effect with {why}: IPST's settings act with scheme = ctvf and pst = ipst"),
-            ));
-        }
-    }
-    if scheme == "tvf" && given("edac_alpha") {
-        return Some((
-            "edac_alpha",
-            "has no effect with `scheme` = tvf: its pressure comes from the state equation".into(),
-        ));
-    }
-    None
+    Some((scheme, pst, options))
+}
+
+/// A scheme option of `p` given (`given(key)`) for a scheme that does not read it, as the
+/// solver's typed settings find it: such a value would be ignored without a word.
+pub fn unused_scheme_option(p: &Params, given: impl Fn(&str) -> bool) -> Option<OptionError> {
+    let (scheme, pst, options) = scheme_options(p, given)?;
+    options.check(scheme, pst).err()
 }
 
 /// Refuses the internal-flow schemes for a scene with a free surface.
@@ -345,8 +330,15 @@ fn pad<const D: usize>(v: &Vector<D>) -> [f64; 3] {
     std::array::from_fn(|k| if k < D { v[k] } else { 0.0 })
 }
 
-/// Writes a fluid snapshot with velocity, speed, pressure, density, id and `extra` fields.
-pub fn write_fluid<const D: usize>(path: &Path, f: &Fluid<D>, extra: Vec<Field>) -> std::io::Result<()> {
+/// Writes a fluid snapshot with velocity, speed, pressure, density, id and the `extra`
+/// fields (one value per particle of the fluid); of the particles whose original index is in
+/// `ids` only, if given (one part of the fluid).
+pub fn write_fluid<const D: usize>(
+    path: &Path,
+    f: &Fluid<D>,
+    extra: &[Field],
+    ids: Option<&std::ops::Range<u32>>,
+) -> std::io::Result<()> {
     let mut fields = vec![
         Field::Vector("velocity", f.u.iter().map(pad).collect()),
         Field::Scalar("speed", f.u.iter().map(|u| u.norm()).collect()),
@@ -354,8 +346,16 @@ pub fn write_fluid<const D: usize>(path: &Path, f: &Fluid<D>, extra: Vec<Field>)
         Field::Scalar("density", f.rho.clone()),
         Field::Int("id", f.id.iter().map(|&i| i as i64).collect()),
     ];
-    fields.extend(extra);
-    write_vtu(path, &f.x.iter().map(pad).collect::<Vec<_>>(), &fields)
+    fields.extend(extra.iter().cloned());
+    let x: Vec<[f64; 3]> = f.x.iter().map(pad).collect();
+    match ids {
+        None => write_vtu(path, &x, &fields),
+        Some(ids) => {
+            let keep: Vec<usize> = (0..f.len()).filter(|&k| ids.contains(&f.id[k])).collect();
+            let fields: Vec<Field> = fields.iter().map(|field| field.select(&keep)).collect();
+            write_vtu(path, &keep.iter().map(|&k| x[k]).collect::<Vec<_>>(), &fields)
+        }
+    }
 }
 
 /// The shifting's time-series columns, every scene alike: IPST's moves in the last step
@@ -380,14 +380,15 @@ pub fn shifting_fields<const D: usize>(sim: &Simulation<D>) -> Vec<Field<'static
 
 /// Writes a wall snapshot: prescribed velocity, extrapolated pressure and density, normal.
 pub fn write_wall<const D: usize>(path: &Path, w: &Wall<D>) -> std::io::Result<()> {
+    let u: Vec<Vector<D>> = (0..w.len()).map(|i| w.velocity(i)).collect();
     write_vtu(
         path,
         &w.x.iter().map(pad).collect::<Vec<_>>(),
         &[
-            Field::Vector("velocity", w.u_wall.iter().map(pad).collect()),
-            Field::Scalar("speed", w.u_wall.iter().map(|u| u.norm()).collect()),
-            Field::Scalar("pressure", w.ghost.iter().map(|g| g.p).collect()),
-            Field::Scalar("density", (0..w.len()).map(|i| w.rho(i)).collect()),
+            Field::Vector("velocity", u.iter().map(pad).collect()),
+            Field::Scalar("speed", u.iter().map(|u| u.norm()).collect()),
+            Field::Scalar("pressure", w.boundary.ghost.iter().map(|g| g.p).collect()),
+            Field::Scalar("density", w.boundary.rho.clone()),
             Field::Vector("normal", w.normal.iter().map(pad).collect()),
         ],
     )
@@ -439,42 +440,59 @@ macro_rules! forward_to_sim {
 pub(crate) use forward_to_sim;
 
 /// The plan written at the top of a run log: the bodies (with `setting`, e.g. the walls'
-/// layout) and the scheme with every term it evaluates.
+/// layout), the kernel and the fluid's scheme with every term it evaluates.
 pub fn plan<const D: usize>(sim: &Simulation<D>, setting: &str) -> String {
-    let f = sim.fluid();
-    let walls =
-        sim.walls.as_ref().map_or(String::new(), |w| format!("; body `wall`: {} particles", w.wall.len()));
-    format!(
-        "body `fluid`: {} particles, h = {:.4e}, kernel {:?}{walls} ({setting})\n{}",
-        f.len(),
-        f.h,
-        sim.kernel.kind(),
-        sim.state.scheme
-    )
+    let mut bodies = Vec::new();
+    for body in sim.bodies() {
+        match body {
+            Body::Fluid(f) => {
+                for part in &f.parts {
+                    bodies.push(format!(
+                        "body `{}`: {} particles, h = {:.4e}",
+                        part.name,
+                        part.ids.len(),
+                        f.h
+                    ));
+                }
+            }
+            Body::Wall(w) => bodies.push(format!("body `{}`: {} particles", w.name, w.len())),
+        }
+    }
+    format!("{}, kernel {:?} ({setting})\n{}", bodies.join("; "), sim.kernel.kind(), sim.fluid().physics)
 }
 
 /// Particles in every body of `sim`.
 pub fn particle_count<const D: usize>(sim: &Simulation<D>) -> usize {
-    sim.fluid().len() + sim.walls.as_ref().map_or(0, |w| w.wall.len())
+    sim.bodies().iter().map(Body::len).sum()
 }
 
-/// Writes the snapshots of every body of `sim` (the fluid with `extra` fields) for output
-/// number `index`; returns the (body, file) pairs.
+/// Writes the snapshots of every body of `sim` (each part of the fluid with `extra` fields)
+/// for output number `index`; returns the (body, file) pairs.
 pub fn snapshot_bodies<const D: usize>(
     sim: &Simulation<D>,
     dir: &Path,
     index: usize,
     extra: Vec<Field>,
 ) -> std::io::Result<Vec<(String, String)>> {
-    let name = format!("fluid_{index:05}.vtu");
     let mut fields = shifting_fields(sim);
     fields.extend(extra);
-    write_fluid(&dir.join(&name), sim.fluid(), fields)?;
-    let mut files = vec![("fluid".to_string(), name)];
-    if let Some(ws) = &sim.walls {
-        let name = format!("wall_{index:05}.vtu");
-        write_wall(&dir.join(&name), &ws.wall)?;
-        files.push(("wall".into(), name));
+    let mut files = Vec::new();
+    for body in sim.bodies() {
+        match body {
+            Body::Fluid(f) => {
+                let whole = f.parts.len() == 1;
+                for part in &f.parts {
+                    let name = format!("{}_{index:05}.vtu", part.name);
+                    write_fluid(&dir.join(&name), f, &fields, (!whole).then_some(&part.ids))?;
+                    files.push((part.name.clone(), name));
+                }
+            }
+            Body::Wall(w) => {
+                let name = format!("{}_{index:05}.vtu", w.name);
+                write_wall(&dir.join(&name), w)?;
+                files.push((w.name.clone(), name));
+            }
+        }
     }
     Ok(files)
 }
@@ -504,13 +522,14 @@ pub fn check_wall_layers(
     Ok(())
 }
 
-/// A fluid at rest on the points `x` (spacing `dx`, density `rho0`) with pressure `p(x)`.
+/// A fluid of `physics` at rest on the points `x` (spacing `dx`, density `rho0`) with
+/// pressure `p(x)`.
 pub fn fluid_at_rest(
     x: Vec<Vector<2>>,
     dx: f64,
     rho0: f64,
     h: f64,
-    transport: bool,
+    physics: FluidScheme,
     p: impl Fn(&Vector<2>) -> f64,
 ) -> Result<Fluid<2>, String> {
     let n = x.len();
@@ -521,7 +540,7 @@ pub fn fluid_at_rest(
         p: x.iter().map(p).collect(),
         x,
     };
-    Fluid::new("fluid", h, init, transport)
+    Fluid::new("fluid", h, init, physics)
 }
 
 /// A wall body from (position, normal) pairs with prescribed velocity `u(x)`.

@@ -122,9 +122,9 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 
 fn dam_break(p: &Params) -> Result<DamBreak, String> {
     let (constants, kernel, h, scheme) = setup(p)?;
-    let (c0, u_ref) = (constants.c0, constants.u_ref);
+    let c0 = constants.c0;
     let column = column(p);
-    let (fluid, wall) = column.bodies(p, h, c0, scheme.transport.is_some())?;
+    let (fluid, wall) = column.bodies(p, h, c0, scheme, G)?;
     let Column { width: l, height: hc, tank: (tw, th), dx } = column;
     // Open above and around the tank: the run-up jets are fast (11-19 m/s measured at the
     // impact on the far wall, where the front of Ritter's solution runs at 2 sqrt(g H) =
@@ -133,8 +133,12 @@ fn dam_break(p: &Params) -> Result<DamBreak, String> {
     // 4 sqrt(g H) climbs to, and as far below, and a tank width on either side.
     let reach = th + 8.0 * hc;
     let domain = Domain::bounded([-tw, -reach], [2.0 * tw, reach]);
-    let time = time_settings(p, c0, u_ref);
-    let sim = Simulation::new(domain, kernel, fluid, Some(wall), scheme, time)
+    let time = time_settings(p);
+    let sim = Simulation::builder(domain, kernel)
+        .body(fluid)
+        .body(wall)
+        .time(time)
+        .build()
         .map_err(|e| format!("scene `dam_break`: {e}"))?;
     Ok(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() })
 }
@@ -221,7 +225,7 @@ impl SceneRun for DamBreak {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::scheme::WallSet;
+    use crate::solver::equations::wall::{ghost, WallSums};
 
     /// The walls' pressure (eqs. 46-52) is summed from the fluid pressure that the
     /// accelerations use: after the surface particles are set to p = 0, not before.
@@ -237,19 +241,30 @@ mod tests {
             run.sim.step(f64::INFINITY).unwrap();
         }
         let sim = &run.sim;
-        let (fluid, walls) = (sim.fluid(), sim.walls.as_ref().unwrap());
-        let surface = &sim.surface.as_ref().unwrap().surface;
+        let fluid = sim.fluid();
+        let wall = sim.walls().next().expect("the tank");
+        let surface = &sim.surface().expect("a free surface").surface;
         assert!(fluid.p.iter().zip(surface).all(|(&p, &s)| !s || p == 0.0), "surface particles at p = 0");
         // The test needs surface particles within a wall particle's support.
         let reach = sim.kernel.support() * fluid.h;
         let touching = (0..fluid.len())
-            .filter(|&i| surface[i] && walls.wall.x.iter().any(|w| (w - fluid.x[i]).norm() < reach))
+            .filter(|&i| surface[i] && wall.x.iter().any(|w| (w - fluid.x[i]).norm() < reach))
             .count();
         assert!(touching > 0, "no surface particle near a wall");
-        let mut fresh = walls.clone();
-        fresh.extrapolate(fluid, sim.state.scheme.gravity_vector());
-        let bits = |w: &WallSet<2>| w.wall.ghost.iter().map(|g| g.p.to_bits()).collect::<Vec<_>>();
-        assert_eq!(bits(walls), bits(&fresh));
+        // Eq. (52) summed afresh over every fluid particle in reach, from the pressures now.
+        let (k, g) = (sim.kernel.scaled(fluid.h), fluid.physics.gravity_vector::<2>());
+        for (i, xw) in wall.x.iter().enumerate() {
+            let mut s = WallSums::default();
+            for j in 0..fluid.len() {
+                let x_wf = xw - fluid.x[j];
+                if x_wf.norm() < reach {
+                    s.add(k.w(x_wf.norm()), x_wf, fluid.p[j], fluid.rho[j], fluid.u[j], fluid.u[j]);
+                }
+            }
+            let p = ghost(&s, Vector::zeros(), true, Vector::zeros(), wall.normal[i], g).p;
+            let got = wall.boundary.ghost[i].p;
+            assert!((got - p).abs() <= 1e-9 * p.abs().max(1.0), "wall particle {i}: {got} against {p}");
+        }
     }
 
     #[test]

@@ -105,19 +105,23 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         ),
     };
     let outer: Vec<bool> = x.iter().map(outer).collect();
-    let fluid = fluid_at_rest(x, dx, RHO0, h, scheme.transport.is_some(), |_| 0.0)?;
+    let fluid = fluid_at_rest(x, dx, RHO0, h, scheme, |_| 0.0)?;
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
-    let time = time_settings(p, 10.0, 1.0);
-    let sim = Simulation::new(domain, kernel, fluid, wall, scheme, time)
+    let time = time_settings(p);
+    let sim = wall
+        .into_iter()
+        .fold(Simulation::builder(domain, kernel).body(fluid), |b, w| b.body(w))
+        .time(time)
+        .build()
         .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
     Ok(Box::new(Demo { sim, outer }))
 }
 
 /// Free-surface snapshot fields of `sim`: normal, surface and near-surface flags.
 pub fn surface_fields(sim: &Simulation<2>) -> Vec<Field<'static>> {
-    let Some(fs) = &sim.surface else { return Vec::new() };
+    let Some(fs) = sim.surface() else { return Vec::new() };
     vec![
         Field::Vector("normal", fs.normal.iter().map(|n| [n[0], n[1], 0.0]).collect()),
         Field::Int("free_surface", fs.surface.iter().map(|&s| s as i64).collect()),
@@ -128,7 +132,7 @@ pub fn surface_fields(sim: &Simulation<2>) -> Vec<Field<'static>> {
 impl Demo {
     fn counts(&self) -> (usize, usize, usize) {
         let f = self.sim.fluid();
-        let fs = self.sim.surface.as_ref().expect("free surface declared");
+        let fs = self.sim.surface().expect("free surface declared");
         let (mut found, mut interior, mut missed) = (0, 0, 0);
         for k in 0..f.len() {
             let outer = self.outer[f.id[k] as usize];

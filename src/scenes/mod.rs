@@ -123,8 +123,8 @@ impl SceneEntry {
         // a case, defaults included, and its problem file was checked with the keys it gives.
         let defaults = Params::defaults(&specs);
         let given = |k: &str| given.contains_key(k) && p.0.get(k) != defaults.0.get(k);
-        if let Some((key, why)) = common::unused_scheme_option(&p, given) {
-            return Err(format!("scene `{}`: parameter `{key}` = {} {why}", self.name, p.0[key]));
+        if let Some(e) = common::unused_scheme_option(&p, given) {
+            return Err(format!("scene `{}`: parameter `{}` = {} {}", self.name, e.key, p.0[e.key], e.why));
         }
         Ok(p)
     }

@@ -12,8 +12,8 @@ use super::geometry::{box_walls, lattice};
 use super::params::Params;
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
-use crate::solver::particles::{Fluid, Wall};
 use crate::solver::scheme::FluidScheme;
+use crate::solver::systems::{Fluid, Wall};
 
 /// Water's density (kg/m^3).
 pub const RHO0: f64 = 1000.0;
@@ -65,18 +65,19 @@ impl Column {
         Ok((constants, kernel, h, scheme))
     }
 
-    /// The fluid at the hydrostatic pressure (smoothing length `h`, with transport
-    /// velocities if `transport`) and the tank's walls (with the wall models `p` asks for).
+    /// The fluid of `physics` at the hydrostatic pressure of gravity `g` (smoothing length
+    /// `h`) and the tank's walls (with the wall models `p` asks for).
     pub fn bodies(
         &self,
         p: &Params,
         h: f64,
         c0: f64,
-        transport: bool,
+        physics: FluidScheme,
+        g: f64,
     ) -> Result<(Fluid<2>, Wall<2>), String> {
         let Self { width, height, tank: (tw, th), dx } = *self;
-        let hydrostatic = |x: &Vector<2>| RHO0 * G * (height - x[1]);
-        let fluid = fluid_at_rest(lattice(0.0, width, 0.0, height, dx), dx, RHO0, h, transport, hydrostatic)?;
+        let hydrostatic = |x: &Vector<2>| RHO0 * g * (height - x[1]);
+        let fluid = fluid_at_rest(lattice(0.0, width, 0.0, height, dx), dx, RHO0, h, physics, hydrostatic)?;
         let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
             .with_models(wall_density(p), wall_pressure(p));
         Ok((fluid, wall))

@@ -29,9 +29,9 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::output::vtu::Field;
-use crate::solver::particles::{Fluid, FluidInit};
 use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::Simulation;
+use crate::solver::systems::{Fluid, FluidInit};
 use rand::{Rng, SeedableRng};
 use std::collections::BTreeMap;
 use std::f64::consts::PI;
@@ -251,9 +251,12 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
             }
         }
     }
-    let fluid = Fluid::new("fluid", h, init, scheme.transport.is_some())?;
-    let time = time_settings(p, C0, U);
-    Simulation::new(domain, kernel, fluid, None, scheme, time)
+    let fluid = Fluid::new("fluid", h, init, scheme)?;
+    let time = time_settings(p);
+    Simulation::builder(domain, kernel)
+        .body(fluid)
+        .time(time)
+        .build()
         .map_err(|e| format!("scene `{}`: {e}", name::<D>()))
 }
 
@@ -390,7 +393,7 @@ mod tests {
             let (mut err, mut norm) = (0.0, 0.0);
             for i in 0..f.len() {
                 let e = exact_acceleration(&f.x[i], 100.0);
-                err += (sim.state.rates.du[i] - e).norm();
+                err += (sim.fluid_rates().du[i] - e).norm();
                 norm += e.norm();
             }
             let rel = err / norm;

@@ -1,10 +1,17 @@
 //! The SPH solver library. It knows nothing of problem files, caches, plots or the CLI.
 //!
-//! - [`kernel`]: smoothing kernels; [`nnps`]: neighbour search;
-//! - [`particles`]: per-body storage; [`equations`]: one function per physics term;
-//! - [`scheme`]: named compositions of the terms and the passes that run them;
-//! - [`integrator`]: kick-drift-kick and the time step; [`simulation`]: the run loop;
-//!   [`warm`]: the pool's workers kept awake while a run steps;
+//! - [`kernel`]: smoothing kernels; [`nnps`]: neighbour search (SPH-free);
+//! - [`systems`]: one module per body kind (fluid, wall, and the boundary model a wall
+//!   embeds), each with its fields, constants, time-step limit and kicks;
+//! - [`equations`]: one function per physics term, citing its equation;
+//! - [`scheme`]: what a fluid scheme is (`edac`, `tvf`, `ctvf` and their switches);
+//! - [`interactions`]: who acts on whom (one exhaustive match over body kinds) and what a
+//!   particle gathers from each neighbour across each pair of bodies;
+//! - [`passes`]: the parallel loops over a body's particles (density, rates,
+//!   accelerations, free surface, IPST);
+//! - [`schedule`]: the wavefront, its tuner and the thread stages, for speed only;
+//! - [`integrator`]: kick-drift-kick updates and the time-step limits;
+//!   [`simulation`]: the bodies and the step as ordered stages;
 //! - [`output`]: ParaView snapshots, time series and the run summary.
 
 /// `NAMES` (the accepted names, in order) and `from_name` for an enum of choices, each
@@ -28,14 +35,16 @@ macro_rules! named_choices {
 
 pub mod equations;
 pub mod integrator;
+pub mod interactions;
 pub mod kernel;
 pub mod math;
 pub mod nnps;
 pub mod output;
-pub mod particles;
+pub mod passes;
+pub mod schedule;
 pub mod scheme;
 pub mod simulation;
-pub mod warm;
+pub mod systems;
 
 /// Particles per rayon task in the loops that do a few flops per particle (kicks, drift,
 /// wrapping, checks, explicit updates): tasks must be long for the scheduling not to

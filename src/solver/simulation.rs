@@ -1,17 +1,39 @@
-//! A simulation: a domain, the bodies, a scheme and the kick-drift-kick loop.
+//! A simulation: a domain, a list of named bodies, who acts on whom, and the
+//! kick-drift-kick loop as an ordered list of stages.
+//!
+//! A step is PySPH's groups: each stage completes over every body before the next starts.
+//!
+//! 1. the opening half kick of every body (eqs. 54-55; a wall's prescribed motion);
+//! 2. (with [`RatePositions::Start`]) the fluid's density and pressure rates and their
+//!    update at the start positions;
+//! 3. the drift of every body (eq. 59), and the moved bodies binned again;
+//! 4. the neighbour lists of every interacting pair, the boundaries' extrapolation
+//!    (eqs. 46-52), the summation density, the density and pressure rates and update
+//!    (eqs. 25-26, 56-57), the extrapolation again, the free surface (sec. 3.4) and the
+//!    accelerations (eq. 27): as sweeps over each body, or, for a scene of one fluid body,
+//!    as a wavefront over tiles ([`Schedule`]);
+//! 5. IPST (eqs. 37-41);
+//! 6. the closing half kick of every body (eq. 60), and the blow-up check.
+//!
+//! The time step is the smallest of the bodies' limits (eq. 61).
 
-use crate::solver::integrator::{self, RatePositions};
+use crate::solver::integrator::RatePositions;
+use crate::solver::interactions::boundary_fluid::BoundaryFluid;
+use crate::solver::interactions::fluid_boundary::{Boundaries, FluidBoundary};
+use crate::solver::interactions::fluid_fluid::FluidFluid;
+use crate::solver::interactions::{interaction, Interaction};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
-use crate::solver::particles::{Fluid, FluidRates, Wall};
-use crate::solver::scheme::{
-    build_kernel_list, build_kernel_list_summing_density, ipst_chi_reference, wavefront_applies,
-    DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, Shifting, StepBodies, SurfaceFields,
-    SurfacePressure, Tuner, WallSet, Wavefront,
-};
-pub use crate::solver::scheme::{Schedule, TUNING_STEPS};
-use crate::solver::{warm, LIGHT_LOOP_LEN};
+use crate::solver::passes::free_surface::SurfaceFields;
+use crate::solver::passes::ipst::{ipst_chi_reference, Ipst, Shifted};
+use crate::solver::passes::{accelerations, density, rates, FluidPasses, Particles};
+use crate::solver::schedule::wavefront::applies as wavefront_applies;
+use crate::solver::schedule::{warm, StepBodies, Tuner, Wavefront};
+pub use crate::solver::schedule::{Schedule, TUNING_STEPS};
+use crate::solver::scheme::{DensityModel, PressureModel, Shifting, SurfacePressure};
+use crate::solver::systems::{Body, Fluid, FluidRates, Rates, Wall};
+use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -31,24 +53,20 @@ pub struct Divergence {
 pub struct TimeSettings {
     /// The factor of eq. (61).
     pub cfl: f64,
-    /// Speed of sound used in the acoustic limit.
-    pub c0: f64,
-    /// Reference velocity: the acoustic limit uses max(u_ref, max |u|).
-    pub u_ref: f64,
-    /// A speed above `blowup_factor * c0` counts as a blow-up, so that a run that grows
-    /// without turning NaN still stops ([`BLOWUP_MACH`] in every scene).
+    /// A speed above `blowup_factor` times a fluid's speed of sound counts as a blow-up, so
+    /// that a run that grows without turning NaN still stops ([`BLOWUP_MACH`] in every
+    /// scene).
     pub blowup_factor: f64,
-    /// Where the density and pressure rates are evaluated (a checkpoint written before the
-    /// choice existed ran `End`, the default).
+    /// Where the density and pressure rates are evaluated.
     #[serde(default)]
     pub rate_positions: RatePositions,
 }
 
 impl TimeSettings {
-    /// The settings of a scene: eq. (61)'s factor, the speed of sound, the reference speed;
-    /// blow-ups at [`BLOWUP_MACH`]; the rates at the default [`RatePositions`].
-    pub fn new(cfl: f64, c0: f64, u_ref: f64) -> Self {
-        Self { cfl, c0, u_ref, blowup_factor: BLOWUP_MACH, rate_positions: RatePositions::default() }
+    /// The settings of a scene: eq. (61)'s factor; blow-ups at [`BLOWUP_MACH`]; the rates at
+    /// the default [`RatePositions`].
+    pub fn new(cfl: f64) -> Self {
+        Self { cfl, blowup_factor: BLOWUP_MACH, rate_positions: RatePositions::default() }
     }
 }
 
@@ -62,18 +80,18 @@ pub const BLOWUP_MACH: f64 = 1.0;
 /// The evolving state that a checkpoint must hold to resume bit for bit.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct State<const D: usize> {
-    /// The fluid body.
-    pub fluid: Fluid<D>,
-    /// Its rates from the last evaluation (the first kick of the next step uses them).
-    pub rates: FluidRates<D>,
+    /// The bodies, with the quantities a run measures at its start (IPST's chi_ref, in the
+    /// fluid's scheme).
+    pub bodies: Vec<Body<D>>,
+    /// Each body's rates from the last evaluation (the first kick of the next step uses
+    /// them), in the order of the bodies.
+    pub rates: Vec<Rates<D>>,
     /// Simulated time.
     pub time: f64,
     /// Steps taken.
     pub steps: u64,
-    /// Largest speed at the last step (for the next time step).
+    /// Largest fluid speed at the last step (for the next time step).
     pub u_max: f64,
-    /// The scheme, with quantities measured at the start (IPST chi_ref).
-    pub scheme: FluidScheme,
     /// IPST moves in the last step (a diagnostic written to the time series).
     pub ipst_iterations: usize,
 }
@@ -84,10 +102,10 @@ pub struct State<const D: usize> {
 pub struct PhaseTimes {
     /// Kicks, drift and the blow-up check.
     pub integrate: f64,
-    /// Wrapping, binning, reordering and the neighbour list with its kernel values (and
+    /// Wrapping, binning, reordering and the neighbour lists with their kernel values (and
     /// the fluid's share of a summation density, summed as the list is built).
     pub neighbours: f64,
-    /// Summation density: the walls' share.
+    /// Summation density: the boundaries' share.
     pub density: f64,
     /// Density and pressure rates and their update (pass A).
     pub pressure: f64,
@@ -129,7 +147,162 @@ fn lap(start: std::time::Instant, acc: &mut f64) -> std::time::Instant {
     now
 }
 
-/// One simulation of one fluid body, optionally bounded by walls, in a domain.
+/// The interactions of a simulation's bodies, as [`interaction`] decides them, each with
+/// its neighbour lists.
+#[derive(Debug)]
+struct Couplings<const D: usize> {
+    /// The fluid among itself.
+    fluid_fluid: FluidFluid<D>,
+    /// The fluid reading each boundary, in the order of the bodies.
+    fluid_boundary: Vec<FluidBoundary<D>>,
+    /// Each boundary extrapolating from the fluid.
+    boundary_fluid: Vec<BoundaryFluid<D>>,
+}
+
+/// What a fluid's passes keep from step to step: the gathered views, IPST's work space,
+/// the free surface.
+#[derive(Debug, Default)]
+struct FluidWork<const D: usize> {
+    passes: FluidPasses<D>,
+    ipst: Ipst<D>,
+    surface: Option<SurfaceFields<D>>,
+}
+
+/// How a simulation is put together ([`Simulation::builder`]).
+pub struct Builder<const D: usize> {
+    domain: Domain<D>,
+    kernel: Kernel,
+    bodies: Vec<Body<D>>,
+    without: Vec<(String, String)>,
+    time: TimeSettings,
+}
+
+impl<const D: usize> Builder<D> {
+    /// Adds a body. Fluid bodies of the same physics become parts of one fluid
+    /// ([`Fluid::merge`]), in the order they are added.
+    pub fn body(mut self, body: impl Into<Body<D>>) -> Self {
+        self.bodies.push(body.into());
+        self
+    }
+
+    /// Switches the interaction of the bodies named `a` and `b` off, both ways: neither
+    /// acts on the other.
+    pub fn without(mut self, a: &str, b: &str) -> Self {
+        self.without.push((a.into(), b.into()));
+        self
+    }
+
+    /// The time loop's settings (by default those of [`TimeSettings::new`] at `cfl` 0.25).
+    pub fn time(mut self, time: TimeSettings) -> Self {
+        self.time = time;
+        self
+    }
+
+    /// Builds the simulation: merges the fluids, decides the interactions, bins and lists
+    /// the particles (the fluid's sorted by cell), and evaluates the initial rates. Errors
+    /// name the body or the setting at fault.
+    pub fn build(self) -> Result<Simulation<D>, String> {
+        let Self { domain, kernel, bodies: given, without, time } = self;
+        let mut bodies: Vec<Body<D>> = Vec::with_capacity(given.len());
+        let mut fluid: Option<usize> = None;
+        for body in given {
+            match (body, fluid) {
+                (Body::Fluid(more), Some(f)) => {
+                    bodies[f].as_fluid_mut().expect("the fluid's index").merge(more)?;
+                }
+                (body, _) => {
+                    if matches!(body, Body::Fluid(_)) {
+                        fluid = Some(bodies.len());
+                    }
+                    bodies.push(body);
+                }
+            }
+        }
+        let fluid = fluid.ok_or("a simulation needs a fluid body")?;
+        let names: Vec<&str> = bodies.iter().flat_map(|b| b.names()).collect();
+        for (k, name) in names.iter().enumerate() {
+            if names[..k].contains(name) {
+                return Err(format!("two bodies are named `{name}`"));
+            }
+        }
+        let index_of = |name: &str| {
+            bodies
+                .iter()
+                .position(|b| b.names().contains(&name))
+                .ok_or_else(|| format!("no body is named `{name}` (bodies: {})", names.join(", ")))
+        };
+        let mut off = Vec::new();
+        for (a, b) in &without {
+            let (i, j) = (index_of(a)?, index_of(b)?);
+            if i == j {
+                return Err(format!("bodies `{a}` and `{b}` are one body: its particles always interact"));
+            }
+            off.extend([(i, j), (j, i)]);
+        }
+        // One exhaustive decision per ordered pair of bodies.
+        let mut fluid_boundary = Vec::new();
+        let mut boundary_fluid = Vec::new();
+        for (i, dst) in bodies.iter().enumerate() {
+            for (j, src) in bodies.iter().enumerate() {
+                if off.contains(&(i, j)) {
+                    continue;
+                }
+                match interaction(dst.kind(), src.kind()) {
+                    // Within the one fluid: its own list.
+                    Some(Interaction::FluidFluid) => debug_assert_eq!(i, j, "one fluid"),
+                    Some(Interaction::FluidBoundary) => fluid_boundary.push(FluidBoundary::new(i, j)),
+                    Some(Interaction::BoundaryFluid) => boundary_fluid.push(BoundaryFluid::new(i, j)),
+                    None => {}
+                }
+            }
+        }
+        let f = bodies[fluid].as_fluid_mut().expect("the fluid's index");
+        f.physics.resolve_reference(!fluid_boundary.is_empty());
+        let radius = kernel.support() * f.h;
+        let surface = f.physics.free_surface.map(|_| SurfaceFields::default());
+        domain.check_periodic(radius)?;
+        let rates = bodies
+            .iter()
+            .map(|b| match b {
+                Body::Fluid(f) => Rates::Fluid(FluidRates::of(f)),
+                Body::Wall(_) => Rates::None,
+            })
+            .collect();
+        // Every body binned with the fluid's search radius (its particles query them all).
+        let bins = bodies
+            .iter()
+            .map(|b| {
+                let mut cells = CellList::new(domain, radius);
+                if !matches!(b, Body::Fluid(_)) {
+                    cells.update(b.x());
+                }
+                cells
+            })
+            .collect();
+        let state = State { bodies, rates, time: 0.0, steps: 0, u_max: 0.0, ipst_iterations: 0 };
+        let mut sim = Simulation {
+            domain,
+            kernel,
+            time_settings: time,
+            state,
+            fluid,
+            bins,
+            couplings: Couplings { fluid_fluid: FluidFluid::new(), fluid_boundary, boundary_fluid },
+            work: FluidWork { surface, ..Default::default() },
+            wave: Wavefront::new(),
+            schedule: Schedule::default(),
+            tuners: Vec::new(),
+            last_schedule: Schedule::Sweeps,
+            wavefront_steps: 0,
+            times: PhaseTimes::default(),
+        };
+        sim.start();
+        Ok(sim)
+    }
+}
+
+/// One simulation: a domain, named bodies (one fluid, any number of walls) and who acts on
+/// whom, stepped by kick-drift-kick.
 pub struct Simulation<const D: usize> {
     /// The box.
     pub domain: Domain<D>,
@@ -139,23 +312,20 @@ pub struct Simulation<const D: usize> {
     pub time_settings: TimeSettings,
     /// Everything that evolves.
     pub state: State<D>,
-    /// The walls, if the scene has any: not integrated, so not part of the state.
-    pub walls: Option<WallSet<D>>,
-    /// Free-surface particles and normals, when the scheme declares a free surface
-    /// (recomputed every step before the accelerations).
-    pub surface: Option<SurfaceFields<D>>,
-    cells: CellList<D>,
-    neighbours: KernelList<D>,
-    /// The fluid's share of the summation density, summed as the list is built.
-    fluid_density: Vec<f64>,
-    passes: FluidPasses<D>,
+    /// The index of the fluid among the bodies.
+    fluid: usize,
+    /// Each body's binning, in the order of the bodies (a body that does not move is binned
+    /// once).
+    bins: Vec<CellList<D>>,
+    couplings: Couplings<D>,
+    work: FluidWork<D>,
     /// The tiles of the wavefront step, the schedule asked for and its tuner, and the steps
     /// that ran as a wavefront.
     wave: Wavefront,
     schedule: Schedule,
     /// A tuner for each number of threads the run has stepped on: which order is faster
-    /// depends on it (at nx = 200, `edac` ran 8-10 % faster in sweeps on two threads and
-    /// 1.25-1.3x faster in tiles on one, session 40).
+    /// depends on it (`edac` at nx = 200 ran 8-10 % faster in sweeps on two threads and
+    /// 1.25-1.3x faster in tiles on one, on one host).
     tuners: Vec<(usize, Tuner)>,
     last_schedule: Schedule,
     wavefront_steps: u64,
@@ -164,93 +334,116 @@ pub struct Simulation<const D: usize> {
 }
 
 impl<const D: usize> Simulation<D> {
-    /// Sets up the neighbour search, sorts the particles by cell and evaluates the initial
-    /// rates. The scheme's free surface, if any, selects the IPST reference (sec. 3.3.2).
-    pub fn new(
-        domain: Domain<D>,
-        kernel: Kernel,
-        fluid: Fluid<D>,
-        wall: Option<Wall<D>>,
-        mut scheme: FluidScheme,
-        time_settings: TimeSettings,
-    ) -> Result<Self, String> {
-        scheme.set_walls(wall.is_some());
-        let radius = kernel.support() * fluid.h;
-        domain.check_periodic(radius)?;
-        let n = fluid.len();
-        let rates = FluidRates::new(
-            n,
-            matches!(scheme.pressure, PressureModel::Edac { .. }),
-            scheme.density == DensityModel::Continuity,
-            scheme.transport.is_some(),
+    /// A simulation in `domain` with `kernel`, to which bodies are added.
+    ///
+    /// ```
+    /// use sphrepro::solver::kernel::{Kernel, KernelKind};
+    /// use sphrepro::solver::math::Vector;
+    /// use sphrepro::solver::nnps::Domain;
+    /// use sphrepro::solver::scheme::{FluidSettings, SchemeName};
+    /// use sphrepro::solver::simulation::Simulation;
+    /// use sphrepro::solver::systems::{Fluid, FluidInit};
+    ///
+    /// // A Taylor-Green vortex of 20 x 20 particles in the periodic unit square, `edac`.
+    /// let (n, dx) = (20, 1.0 / 20.0);
+    /// let mut init = FluidInit::<2>::default();
+    /// for k in 0..n * n {
+    ///     let x = Vector::<2>::new(((k % n) as f64 + 0.5) * dx, ((k / n) as f64 + 0.5) * dx);
+    ///     let (a, b) = (2.0 * std::f64::consts::PI * x[0], 2.0 * std::f64::consts::PI * x[1]);
+    ///     init.u.push(Vector::<2>::new(-a.cos() * b.sin(), a.sin() * b.cos()));
+    ///     init.x.push(x);
+    ///     init.m.push(dx * dx);
+    ///     init.rho.push(1.0);
+    ///     init.p.push(0.0);
+    /// }
+    /// let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    /// // rho0 = 1, c0 = 10, U = 1, h = dx, W(dx), nu = 0.01 (Re = 100)
+    /// let settings = FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01);
+    /// let fluid = Fluid::new("fluid", dx, init, SchemeName::Edac.fluid_scheme(&settings))?;
+    /// let mut sim = Simulation::builder(Domain::periodic([0.0; 2], [1.0; 2]), kernel).body(fluid).build()?;
+    /// sim.advance(0.05, 0.05, |_| true).map_err(|d| d.reason)?;
+    /// assert!(sim.time() >= 0.05 && sim.max_speed() < 1.0);
+    /// # Ok::<(), String>(())
+    /// ```
+    pub fn builder(domain: Domain<D>, kernel: Kernel) -> Builder<D> {
+        Builder { domain, kernel, bodies: Vec::new(), without: Vec::new(), time: TimeSettings::new(0.25) }
+    }
+
+    /// Sorts and lists the particles and evaluates the initial rates: IPST's reference
+    /// (sec. 3.3.2), the summation density or the state equation's pressure, and the
+    /// accelerations for the first half kick (the pressure is the initial one).
+    fn start(&mut self) {
+        self.rebin();
+        self.relist();
+        let free_surface = self.fluid().physics.free_surface.is_some();
+        let fluid = self.fluid();
+        let reference = ipst_chi_reference(
+            (&fluid.x, fluid.h),
+            &self.couplings.fluid_fluid.list,
+            self.boundaries(),
+            &self.kernel,
+            free_surface,
         );
-        let state = State { fluid, rates, time: 0.0, steps: 0, u_max: 0.0, scheme, ipst_iterations: 0 };
-        let mut sim = Self {
-            domain,
-            kernel,
-            time_settings,
-            state,
-            walls: wall.map(|w| WallSet::new(w, domain, radius)),
-            surface: scheme.free_surface.map(|_| SurfaceFields::default()),
-            cells: CellList::new(domain, radius),
-            neighbours: KernelList::new(),
-            fluid_density: Vec::new(),
-            passes: FluidPasses::new(),
-            wave: Wavefront::new(),
-            schedule: Schedule::default(),
-            tuners: Vec::new(),
-            last_schedule: Schedule::Sweeps,
-            wavefront_steps: 0,
-            times: PhaseTimes::default(),
-        };
-        sim.rebuild();
-        let free_surface = scheme.free_surface.is_some();
-        if let Some(t) = scheme.transport.as_mut() {
+        let f = self.fluid;
+        let fluid = self.state.bodies[f].as_fluid_mut().expect("the fluid's index");
+        if let Some(t) = fluid.physics.transport.as_mut() {
             if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
-                *chi_ref = ipst_chi_reference(
-                    &sim.state.fluid,
-                    &sim.neighbours,
-                    sim.walls.as_ref(),
-                    &sim.kernel,
-                    free_surface,
-                );
+                *chi_ref = reference;
             }
         }
-        sim.state.scheme = scheme;
-        sim.state.u_max = sim.max_speed();
-        // Initial accelerations for the first half kick; the pressure is the initial one.
-        if sim.state.scheme.density == DensityModel::Summation {
-            FluidPasses::summation_density(&mut sim.state.fluid, &sim.fluid_density, sim.walls.as_ref());
+        self.state.u_max = self.max_speed();
+        if self.fluid().physics.density == DensityModel::Summation {
+            self.summation_density();
         }
-        if let PressureModel::StateEquation { .. } = sim.state.scheme.pressure {
-            let st = &mut sim.state;
-            sim.passes.update_density_and_pressure(
-                &mut st.fluid,
-                &sim.neighbours,
-                sim.walls.as_ref(),
-                &st.scheme,
-                &mut st.rates,
-                0.0,
-            );
-            sim.extrapolate_walls();
+        if let PressureModel::StateEquation { .. } = self.fluid().physics.pressure {
+            self.density_and_pressure(0.0);
+            self.extrapolate();
         }
-        let dt = sim.nominal_dt();
-        sim.evaluate_accelerations(dt, 0);
-        Ok(sim)
+        let dt = self.nominal_dt();
+        self.accelerations(dt);
+        self.homogenise(dt, 0);
     }
 
     /// Replaces the evolving state by a checkpointed one (taken at a step boundary of a
-    /// simulation built from the same parameters). The particles are stored in cell order,
-    /// so re-binning them reproduces the neighbour order, and the run continues bit for bit.
+    /// simulation built from the same parameters). The fluid's particles are stored in cell
+    /// order, so re-binning them reproduces the neighbour order, and the run continues bit
+    /// for bit.
     pub fn restore(&mut self, state: State<D>) {
         self.state = state;
-        self.cells.update(&self.state.fluid.x);
+        for (k, body) in self.state.bodies.iter_mut().enumerate() {
+            if let Body::Wall(w) = body {
+                w.boundary.resize();
+                self.bins[k].update(&w.x);
+            }
+        }
+        let f = self.fluid;
+        self.bins[f].update(self.state.bodies[f].x());
         self.relist();
     }
 
-    /// The fluid body.
+    /// The fluid (all its parts).
     pub fn fluid(&self) -> &Fluid<D> {
-        &self.state.fluid
+        self.state.bodies[self.fluid].as_fluid().expect("the fluid's index")
+    }
+
+    /// The fluid's rates.
+    pub fn fluid_rates(&self) -> &FluidRates<D> {
+        self.state.rates[self.fluid].as_fluid().expect("the fluid's rates")
+    }
+
+    /// The bodies, in order.
+    pub fn bodies(&self) -> &[Body<D>] {
+        &self.state.bodies
+    }
+
+    /// The walls, in the order of the bodies.
+    pub fn walls(&self) -> impl Iterator<Item = &Wall<D>> {
+        self.state.bodies.iter().filter_map(Body::as_wall)
+    }
+
+    /// The fluid's free surface, if its scheme detects one (after the first evaluation).
+    pub fn surface(&self) -> Option<&SurfaceFields<D>> {
+        self.work.surface.as_ref()
     }
 
     /// Simulated time.
@@ -268,20 +461,27 @@ impl<const D: usize> Simulation<D> {
         self.state.ipst_iterations
     }
 
-    /// Wraps positions into the box, sorts the particles by cell and lists neighbours;
-    /// then the wall pressure and velocities from the fluid.
-    fn rebuild(&mut self) {
-        self.rebin();
-        self.relist();
+    /// The boundaries the fluid reads.
+    fn boundaries(&self) -> Boundaries<'_, D> {
+        Boundaries::new(&self.couplings.fluid_boundary, &self.state.bodies)
     }
 
-    /// Wraps positions into the box and sorts the particles by cell.
+    /// Wraps the fluid's positions into the box and sorts its particles by cell, and bins
+    /// again every other body that moves.
     fn rebin(&mut self) {
-        let (domain, fluid) = (&self.domain, &mut self.state.fluid);
-        fluid.x.par_iter_mut().with_min_len(LIGHT_LOOP_LEN).for_each(|x| domain.wrap(x));
-        self.cells.update(&fluid.x);
-        fluid.reorder(self.cells.order());
-        self.cells.mark_reordered();
+        let domain = self.domain;
+        for (body, cells) in self.state.bodies.iter_mut().zip(&mut self.bins) {
+            match body {
+                Body::Fluid(fluid) => {
+                    fluid.x.par_iter_mut().with_min_len(LIGHT_LOOP_LEN).for_each(|x| domain.wrap(x));
+                    cells.update(&fluid.x);
+                    fluid.reorder(cells.order());
+                    cells.mark_reordered();
+                }
+                Body::Wall(wall) if wall.moves() => cells.update(&wall.x),
+                Body::Wall(_) => {}
+            }
+        }
     }
 
     /// Steps of this simulation (since it was built) whose listing and passes ran as a
@@ -304,15 +504,16 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// How this step's listing and passes run: as the schedule asks, or as the tuner
-    /// picks, where the scheme allows a wavefront ([`Wavefront`]) and the body, as binned
-    /// now, makes enough tiles for it; else as sweeps. Also whether the tuner times the step.
+    /// picks, where the scene allows a wavefront (one fluid body, a scheme it
+    /// [applies](wavefront_applies) to) and the body, as binned now, makes enough tiles for
+    /// it; else as sweeps. Also whether the tuner times the step.
     fn order(&mut self) -> (Schedule, bool) {
-        let st = &self.state;
+        let fluid = self.fluid();
         let allowed = self.schedule != Schedule::Sweeps
             && self.time_settings.rate_positions == RatePositions::End
-            && wavefront_applies(&st.scheme, self.walls.is_some());
-        let n = st.fluid.len();
-        let (wave, cells) = (&mut self.wave, &self.cells);
+            && wavefront_applies(&fluid.physics, self.state.bodies.len() == 1);
+        let n = fluid.len();
+        let (wave, cells) = (&mut self.wave, &self.bins[self.fluid]);
         match self.schedule {
             _ if !allowed => (Schedule::Sweeps, false),
             Schedule::Wavefront if wave.plan(cells, n) => (self.schedule, false),
@@ -337,17 +538,17 @@ impl<const D: usize> Simulation<D> {
     /// The listing, summation density, pass A over `dt` and pass B of a step as a
     /// wavefront over the tiles just planned.
     fn wavefront_passes(&mut self, dt: f64, dt_nominal: f64) {
+        let f = self.fluid;
         let st = &mut self.state;
         let bodies = StepBodies {
-            fluid: &mut st.fluid,
-            cells: &self.cells,
+            fluid: st.bodies[f].as_fluid_mut().expect("the fluid's index"),
+            cells: &self.bins[f],
             kernel: &self.kernel,
-            list: &mut self.neighbours,
-            fluid_density: &mut self.fluid_density,
-            scheme: &st.scheme,
-            rates: &mut st.rates,
+            own: &mut self.couplings.fluid_fluid,
+            passes: &mut self.work.passes,
+            rates: st.rates[f].as_fluid_mut().expect("the fluid's rates"),
         };
-        let t = self.passes.wavefront_step(&mut self.wave, bodies, dt, dt_nominal);
+        let t = self.wave.step(bodies, dt, dt_nominal);
         self.times.neighbours += t.list;
         self.times.pressure += t.pressure;
         self.times.accelerations += t.accelerations;
@@ -360,40 +561,59 @@ impl<const D: usize> Simulation<D> {
         let clock = std::time::Instant::now();
         self.relist();
         let mut clock = lap(clock, &mut self.times.neighbours);
-        if self.state.scheme.density == DensityModel::Summation {
-            let walls = self.walls.as_ref();
-            FluidPasses::summation_density(&mut self.state.fluid, &self.fluid_density, walls);
+        if self.fluid().physics.density == DensityModel::Summation {
+            self.summation_density();
             clock = lap(clock, &mut self.times.density);
         }
         if self.time_settings.rate_positions == RatePositions::End {
-            self.update_density_and_pressure(dt);
+            self.density_and_pressure(dt);
         }
-        // The walls follow the fluid's new pressure before the accelerations use it.
-        self.extrapolate_walls();
+        // The boundaries follow the fluid's new pressure before the accelerations use it.
+        self.extrapolate();
         lap(clock, &mut self.times.pressure);
         self.accelerations(dt_nominal);
     }
 
-    /// The neighbour lists from the current binning, and the wall extrapolation.
+    /// The neighbour lists of every interacting pair from the current binning, and the
+    /// boundaries' extrapolation.
     fn relist(&mut self) {
-        let fluid = &self.state.fluid;
-        if self.state.scheme.density == DensityModel::Summation {
-            let rho = &mut self.fluid_density;
-            build_kernel_list_summing_density(&mut self.neighbours, &self.cells, fluid, &self.kernel, rho);
-        } else {
-            build_kernel_list(&mut self.neighbours, &self.cells, fluid, &self.kernel);
+        let (bodies, bins, kernel) = (&self.state.bodies, &self.bins, &self.kernel);
+        let f = self.fluid;
+        let fluid = bodies[f].as_fluid().expect("the fluid's index");
+        self.couplings.fluid_fluid.relist(&bins[f], fluid, kernel);
+        for c in &mut self.couplings.fluid_boundary {
+            c.relist(&bins[c.boundary], bodies[c.boundary].x(), &fluid.x, fluid.h, kernel);
         }
-        if let Some(ws) = self.walls.as_mut() {
-            ws.relist(fluid, &self.cells, &self.kernel);
+        for c in &mut self.couplings.boundary_fluid {
+            c.relist(&bins[c.fluid], fluid, bodies[c.boundary].x(), kernel);
         }
-        self.extrapolate_walls();
+        self.extrapolate();
     }
 
-    /// Eqs. (46)-(52) on the walls from the fluid's current state.
-    fn extrapolate_walls(&mut self) {
-        if let Some(ws) = self.walls.as_mut() {
-            ws.extrapolate(&self.state.fluid, self.state.scheme.gravity_vector());
+    /// Eqs. (46)-(52) on every boundary from the fluid's current state.
+    fn extrapolate(&mut self) {
+        for c in &self.couplings.boundary_fluid {
+            let [boundary, fluid] =
+                self.state.bodies.get_disjoint_mut([c.boundary, c.fluid]).expect("a boundary and a fluid");
+            let fluid = fluid.as_fluid().expect("a boundary extrapolates from a fluid");
+            let g = fluid.physics.gravity_vector();
+            match boundary {
+                Body::Wall(wall) => c.extrapolate(wall, fluid, g),
+                Body::Fluid(_) => unreachable!("a fluid is no boundary"),
+            }
         }
+    }
+
+    /// The fluid's summation density: its own share, summed as its list was built, and
+    /// each boundary's.
+    fn summation_density(&mut self) {
+        let f = self.fluid;
+        // Out of the body while the boundaries, among the bodies, are read (a move, no copy).
+        let mut rho = std::mem::take(&mut self.state.bodies[f].as_fluid_mut().expect("the fluid").rho);
+        let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &self.state.bodies);
+        let own = &self.couplings.fluid_fluid.density;
+        density::summation_density(&mut rho, self.state.bodies[f].x(), own, boundaries);
+        self.state.bodies[f].as_fluid_mut().expect("the fluid").rho = rho;
     }
 
     /// Each fluid particle's shifting speed in the coming step, |u~ - u| = dt_c/2 |(du/dt)_c|
@@ -402,72 +622,76 @@ impl<const D: usize> Simulation<D> {
     /// velocity. (The stored u~ is of the last half step and u of the full step, so their
     /// difference also holds dt/2 du/dt.)
     pub fn shift_speeds(&self) -> Option<Vec<f64>> {
-        self.state.fluid.u_hat.as_ref()?;
-        let half_dt = 0.5 * self.state.rates.a_c_dt.unwrap_or_else(|| self.nominal_dt());
-        Some(self.state.rates.a_c.iter().map(|a| half_dt * a.norm()).collect())
+        self.fluid().u_hat.as_ref()?;
+        let rates = self.fluid_rates();
+        let half_dt = 0.5 * rates.a_c_dt.unwrap_or_else(|| self.nominal_dt());
+        Some(rates.a_c.iter().map(|a| half_dt * a.norm()).collect())
     }
 
-    /// The time step of eq. (61) from the current largest speed.
+    /// The time step of eq. (61): the smallest of the bodies' limits at the current largest
+    /// speed.
     pub fn nominal_dt(&self) -> f64 {
-        let s = &self.state.scheme;
-        let g = s.gravity.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let ts = &self.time_settings;
-        integrator::time_step(
-            ts.cfl,
-            self.state.fluid.h,
-            ts.c0,
-            ts.u_ref.max(self.state.u_max),
-            s.viscosity,
-            g,
-        )
-    }
-
-    /// The accelerations of the state, for step `next_step` (0 the first).
-    fn evaluate_accelerations(&mut self, dt_nominal: f64, next_step: u64) {
-        self.accelerations(dt_nominal);
-        self.homogenise(dt_nominal, next_step);
+        let (cfl, u_max) = (self.time_settings.cfl, self.state.u_max);
+        self.state.bodies.iter().filter_map(|b| b.dt_limit(cfl, u_max)).fold(f64::INFINITY, f64::min)
     }
 
     /// The free surface, if declared, and pass B.
     fn accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
-        if let (Some(fs), Some(free)) = (self.surface.as_mut(), self.state.scheme.free_surface) {
-            let st = &mut self.state;
-            fs.detect(&st.fluid, &self.neighbours, self.walls.as_ref(), free.rho0);
-            fs.apply_surface_pressure(free.pressure, free.rho0, &mut st.fluid.p);
+        let f = self.fluid;
+        let free = self.fluid().physics.free_surface;
+        if let (Some(fs), Some(free)) = (self.work.surface.as_mut(), free) {
+            let fluid = self.state.bodies[f].as_fluid().expect("the fluid");
+            let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &self.state.bodies);
+            let nl = &self.couplings.fluid_fluid.list;
+            fs.detect(Particles::of(fluid), nl, boundaries, free.rho0);
+            let fluid = self.state.bodies[f].as_fluid_mut().expect("the fluid");
+            fs.apply_surface_pressure(free.pressure, free.rho0, &mut fluid.p);
             if free.pressure != SurfacePressure::Evolve {
-                // The walls' pressure (eqs. 46-52) sums the fluid's, so it follows the
+                // The boundaries' pressure (eqs. 46-52) sums the fluid's, so it follows the
                 // surface pressures just set: a wall under a splash's front sees p = 0 there.
-                self.extrapolate_walls();
+                self.extrapolate();
             }
         }
-        let (st, walls) = (&mut self.state, self.walls.as_ref());
-        let surface = self.surface.as_ref();
-        self.passes.accelerations(
-            &st.fluid,
-            &self.neighbours,
-            walls,
-            surface,
-            &st.scheme,
-            &mut st.rates,
+        let st = &mut self.state;
+        let fluid = st.bodies[f].as_fluid().expect("the fluid");
+        let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &st.bodies);
+        let rates = st.rates[f].as_fluid_mut().expect("the fluid's rates");
+        accelerations::accelerations(
+            &mut self.work.passes,
+            fluid,
+            &self.couplings.fluid_fluid.list,
+            boundaries,
+            self.work.surface.as_ref(),
+            rates,
             dt_nominal,
         );
         lap(clock, &mut self.times.accelerations);
     }
 
-    /// IPST's pass (eqs. 37-41), if the scheme shifts with it, after pass B.
+    /// IPST's pass (eqs. 37-41), if the fluid shifts with it, after pass B.
     fn homogenise(&mut self, dt_nominal: f64, next_step: u64) {
         let clock = std::time::Instant::now();
-        let (st, walls) = (&mut self.state, self.walls.as_ref());
-        st.ipst_iterations = self.passes.ipst(
-            &st.fluid,
-            &self.neighbours,
-            &self.cells,
-            walls,
-            self.surface.as_ref(),
+        let f = self.fluid;
+        let st = &mut self.state;
+        let fluid = st.bodies[f].as_fluid().expect("the fluid");
+        let rates = st.rates[f].as_fluid_mut().expect("the fluid's rates");
+        let body = Shifted {
+            x: &fluid.x,
+            // The views pass B gathered at these positions: IPST reads their volumes.
+            points: &self.work.passes.points,
+            h: fluid.h,
+            nl: &self.couplings.fluid_fluid.list,
+            cells: &self.bins[f],
+            boundaries: Boundaries::new(&self.couplings.fluid_boundary, &st.bodies),
+        };
+        let shifting = fluid.physics.transport.map(|t| t.shifting);
+        st.ipst_iterations = self.work.ipst.run(
+            body,
+            self.work.surface.as_ref(),
             &self.kernel,
-            &st.scheme,
-            &mut st.rates,
+            shifting,
+            &mut rates.a_c,
             dt_nominal,
             next_step,
         );
@@ -475,45 +699,43 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Pass A: the density and pressure rates (eqs. 25-26) on the current neighbour lists
-    /// and walls, and their updates over `dt` (eqs. 56-57).
-    fn update_density_and_pressure(&mut self, dt: f64) {
-        let (st, walls) = (&mut self.state, self.walls.as_ref());
-        self.passes.update_density_and_pressure(
-            &mut st.fluid,
-            &self.neighbours,
-            walls,
-            &st.scheme,
-            &mut st.rates,
-            dt,
+    /// and boundaries, and their updates over `dt` (eqs. 56-57).
+    fn density_and_pressure(&mut self, dt: f64) {
+        let f = self.fluid;
+        let st = &mut self.state;
+        let fluid = st.bodies[f].as_fluid().expect("the fluid");
+        let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &st.bodies);
+        let r = st.rates[f].as_fluid_mut().expect("the fluid's rates");
+        rates::density_and_pressure_rates(
+            &mut self.work.passes,
+            fluid,
+            &self.couplings.fluid_fluid.list,
+            boundaries,
+            r,
         );
+        let fluid = st.bodies[f].as_fluid_mut().expect("the fluid");
+        rates::update_density_and_pressure(fluid, st.rates[f].as_fluid().expect("the fluid's rates"), dt);
     }
 
-    /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60): the half kick and the
-    /// transport velocity (eqs. 54-55); the drift (eq. 59); the accelerations at the new
-    /// positions and the closing half kick (eq. 60). The density and pressure rates
-    /// (eqs. 25-26) and their updates (eqs. 56-57) come after the drift, or before it, at
-    /// the start positions, as sec. 3.7 orders them ([`RatePositions`]).
+    /// One kick-drift-kick step of at most `max_dt` (eqs. 54-60), in the stages of the
+    /// module's documentation.
     pub fn step(&mut self, max_dt: f64) -> Result<(), Divergence> {
         let step_clock = std::time::Instant::now();
         let clock = step_clock;
         let dt_nominal = self.nominal_dt();
         let dt = dt_nominal.min(max_dt);
         let rates_at = self.time_settings.rate_positions;
-        {
-            let st = &mut self.state;
-            let Fluid { u, u_hat, .. } = &mut st.fluid;
-            let r = &st.rates;
-            integrator::kick_transport(u, u_hat.as_deref_mut(), &r.du, &r.a_c, r.a_c_dt, dt);
+        for (body, rates) in self.state.bodies.iter_mut().zip(&self.state.rates) {
+            body.kick_open(rates, dt);
         }
         let mut clock = lap(clock, &mut self.times.integrate);
         if rates_at == RatePositions::Start {
-            // The neighbour lists and the walls are still those of the start positions.
-            self.update_density_and_pressure(dt);
+            // The neighbour lists and the boundaries are still those of the start positions.
+            self.density_and_pressure(dt);
             clock = lap(clock, &mut self.times.pressure);
         }
-        {
-            let Fluid { x, u, u_hat, .. } = &mut self.state.fluid;
-            integrator::drift(x, u_hat.as_deref().unwrap_or(u), dt);
+        for body in &mut self.state.bodies {
+            body.drift(dt);
         }
         let clock = lap(clock, &mut self.times.integrate);
         self.rebin();
@@ -529,8 +751,10 @@ impl<const D: usize> Simulation<D> {
         }
         self.homogenise(dt_nominal, self.state.steps + 1);
         let clock = std::time::Instant::now();
+        for (body, rates) in self.state.bodies.iter_mut().zip(&self.state.rates) {
+            body.kick_close(rates, dt);
+        }
         let st = &mut self.state;
-        integrator::kick(&mut st.fluid.u, &st.rates.du, dt);
         st.time += dt;
         st.steps += 1;
         let result = self.check();
@@ -565,10 +789,9 @@ impl<const D: usize> Simulation<D> {
         })
     }
 
-    /// Largest particle speed.
+    /// Largest fluid particle speed.
     pub fn max_speed(&self) -> f64 {
-        self.state
-            .fluid
+        self.fluid()
             .u
             .par_iter()
             .with_min_len(LIGHT_LOOP_LEN)
@@ -580,7 +803,7 @@ impl<const D: usize> Simulation<D> {
     /// Blow-up detection: non-finite fields, speeds beyond the bound, particles outside a
     /// bounded domain. Also records the largest speed for the next time step.
     fn check(&mut self) -> Result<(), Divergence> {
-        let f = &self.state.fluid;
+        let f = self.fluid();
         let domain = &self.domain;
         // (max |u|^2, first bad particle index) over particles; max and min are exact
         // and order-independent, so the outcome does not depend on the thread count.
@@ -612,12 +835,12 @@ impl<const D: usize> Simulation<D> {
             return Err(fail(format!(
                 "{what} (particle {} of body `{}`, at {:?})",
                 f.id[bad],
-                f.name,
+                f.part_of(f.id[bad]),
                 f.x[bad].as_slice()
             )));
         }
         let u_max = u2.sqrt();
-        let bound = self.time_settings.blowup_factor * self.time_settings.c0;
+        let bound = self.time_settings.blowup_factor * f.physics.c0;
         if u_max > bound {
             // Which particle (found only now, on the way out), so that the report says where.
             let fast = (0..f.len()).max_by(|&a, &b| f.u[a].norm_squared().total_cmp(&f.u[b].norm_squared()));
@@ -626,7 +849,7 @@ impl<const D: usize> Simulation<D> {
                 "max |u| = {u_max:.4e} exceeds {} c0 = {bound:.4e}: the flow has left the weakly compressible model (particle {} of body `{}`, at {:?}, p = {:.4e}, rho = {:.4e})",
                 self.time_settings.blowup_factor,
                 f.id[fast],
-                f.name,
+                f.part_of(f.id[fast]),
                 f.x[fast].as_slice(),
                 f.p[fast],
                 f.rho[fast]
@@ -636,9 +859,9 @@ impl<const D: usize> Simulation<D> {
         Ok(())
     }
 
-    /// Positions wrapped into the box, for output.
+    /// The fluid's positions, wrapped into the box, for output.
     pub fn positions(&self) -> &[Vector<D>] {
-        &self.state.fluid.x
+        &self.fluid().x
     }
 }
 
@@ -655,12 +878,25 @@ fn tuner_for(tuners: &mut Vec<(usize, Tuner)>) -> &mut Tuner {
     &mut tuners[k].1
 }
 
+impl<const D: usize> From<Fluid<D>> for Body<D> {
+    fn from(f: Fluid<D>) -> Self {
+        Body::Fluid(f)
+    }
+}
+
+impl<const D: usize> From<Wall<D>> for Body<D> {
+    fn from(w: Wall<D>) -> Self {
+        Body::Wall(w)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::integrator;
     use crate::solver::kernel::KernelKind;
-    use crate::solver::particles::FluidInit;
-    use crate::solver::scheme::{FluidSettings, Pst, SchemeName};
+    use crate::solver::scheme::{FluidSettings, Pst, SchemeName, Transport};
+    use crate::solver::systems::FluidInit;
 
     /// A Taylor-Green-like vortex on a perturbed 16x16 lattice in a periodic unit box,
     /// CTVF with IPST, with the rates taken at `rates_at`.
@@ -702,10 +938,100 @@ mod tests {
         let kernel = Kernel::new(kind, 2);
         let settings =
             FluidSettings { pst, ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01) };
-        let scheme = scheme.fluid_scheme(&settings);
-        let fluid = Fluid::new("fluid", dx, init, true).unwrap();
-        let time = TimeSettings { rate_positions: rates_at, ..TimeSettings::new(0.25, 10.0, 1.0) };
-        Simulation::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel, fluid, None, scheme, time).unwrap()
+        let fluid = Fluid::new("fluid", dx, init, scheme.fluid_scheme(&settings)).unwrap();
+        let time = TimeSettings { rate_positions: rates_at, ..TimeSettings::new(0.25) };
+        Simulation::builder(Domain::periodic([0.0; 2], [1.0; 2]), kernel)
+            .body(fluid)
+            .time(time)
+            .build()
+            .unwrap()
+    }
+
+    /// A fluid split into two named bodies (its lower and upper halves, each added as a body
+    /// of its own) steps as the whole does, bit for bit, on one and two threads: both parts
+    /// are one fluid to the passes, so every sum runs over the same neighbours in the same
+    /// order. Each part keeps its name and its particles.
+    #[test]
+    fn a_fluid_split_into_two_bodies_steps_as_one() {
+        let whole = vortex_sized(32, SchemeName::Ctvf, Pst::Ipst, RatePositions::End);
+        let f = whole.fluid();
+        let half = f.len() / 2;
+        let init_part = |range: std::ops::Range<usize>| FluidInit {
+            x: f.by_id(&f.x)[range.clone()].to_vec(),
+            u: f.by_id(&f.u)[range.clone()].to_vec(),
+            m: f.by_id(&f.m)[range.clone()].to_vec(),
+            rho: vec![1.0; range.len()],
+            p: vec![0.0; range.len()],
+        };
+        let (lower, upper) = (init_part(0..half), init_part(half..f.len()));
+        let physics = {
+            let mut s = f.physics;
+            if let Some(Transport { shifting: Shifting::Ipst { chi_ref, .. }, .. }) = s.transport.as_mut() {
+                *chi_ref = f64::NAN;
+            }
+            s
+        };
+        let (h, kernel, domain, time) = (f.h, whole.kernel, whole.domain, whole.time_settings);
+        let run = |split: bool, threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                let builder = Simulation::builder(domain, kernel).time(time);
+                let mut sim = if split {
+                    builder
+                        .body(Fluid::new("lower", h, lower.clone(), physics).unwrap())
+                        .body(Fluid::new("upper", h, upper.clone(), physics).unwrap())
+                } else {
+                    let mut all = lower.clone();
+                    for (a, b) in [(&mut all.x, &upper.x), (&mut all.u, &upper.u)] {
+                        a.extend_from_slice(b);
+                    }
+                    all.m.extend_from_slice(&upper.m);
+                    all.rho.extend_from_slice(&upper.rho);
+                    all.p.extend_from_slice(&upper.p);
+                    builder.body(Fluid::new("fluid", h, all, physics).unwrap())
+                }
+                .build()
+                .unwrap();
+                for _ in 0..20 {
+                    sim.step(f64::INFINITY).unwrap();
+                }
+                let f = sim.fluid();
+                let r = sim.fluid_rates();
+                let mut bits: Vec<u64> =
+                    [&f.rho, &f.p].iter().flat_map(|v| f.by_id(v)).map(|x| x.to_bits()).collect();
+                for v in [&f.x, &f.u, &r.du, &r.a_c] {
+                    bits.extend(f.by_id(v).iter().flat_map(|x| x.iter().map(|c| c.to_bits())));
+                }
+                let parts: Vec<(String, std::ops::Range<u32>)> =
+                    f.parts.iter().map(|p| (p.name.clone(), p.ids.clone())).collect();
+                (bits, parts)
+            })
+        };
+        let (one, parts_one) = run(false, 1);
+        assert_eq!(parts_one, [("fluid".to_string(), 0..1024)]);
+        for threads in [1, 2] {
+            let (two, parts) = run(true, threads);
+            assert!(one == two, "{threads} threads: the split fluid differs from the whole");
+            assert_eq!(parts, [("lower".to_string(), 0..512), ("upper".to_string(), 512..1024)]);
+        }
+    }
+
+    /// Bodies are named once; a pair switched off must name two bodies.
+    #[test]
+    fn bodies_are_named_once_and_pairs_switched_off_by_name() {
+        let sim = vortex(RatePositions::End);
+        let f = sim.fluid().clone();
+        let builder = || Simulation::builder(sim.domain, sim.kernel);
+        let twice = builder().body(f.clone()).body(f.clone()).build().err().unwrap();
+        assert_eq!(twice, "two bodies are named `fluid`");
+        let unknown = builder().body(f.clone()).without("fluid", "lid").build().err().unwrap();
+        assert_eq!(unknown, "no body is named `lid` (bodies: fluid)");
+        let itself = builder().body(f).without("fluid", "fluid").build().err().unwrap();
+        assert!(itself.contains("are one body"), "{itself}");
+        assert_eq!(
+            Simulation::<2>::builder(sim.domain, sim.kernel).build().err().unwrap(),
+            "a simulation needs a fluid body"
+        );
     }
 
     /// Eq. (55) with eqs. (36) and (41): the shifting techniques divide (du/dt)_c by the step
@@ -719,13 +1045,12 @@ mod tests {
                 sim.step(f64::INFINITY).unwrap();
             }
             let dt = sim.nominal_dt();
-            assert_eq!(sim.state.rates.a_c_dt, Some(dt), "{pst:?}: scaled for the nominal step");
-            let before = sim.state.clone();
+            assert_eq!(sim.fluid_rates().a_c_dt, Some(dt), "{pst:?}: scaled for the nominal step");
+            let (f, r) = (sim.fluid().clone(), sim.fluid_rates().clone());
             let short = 0.25 * dt;
             sim.step(short).unwrap();
-            let f = &before.fluid;
-            let (u, du, ac) = (f.by_id(&f.u), f.by_id(&before.rates.du), f.by_id(&before.rates.a_c));
-            let after = &sim.state.fluid;
+            let (u, du, ac) = (f.by_id(&f.u), f.by_id(&r.du), f.by_id(&r.a_c));
+            let after = sim.fluid();
             let u_hat = after.by_id(after.u_hat.as_ref().unwrap());
             let mut largest_shift: f64 = 0.0;
             for i in 0..u.len() {
@@ -752,22 +1077,21 @@ mod tests {
             }
             // By hand: the half kick and u~ (eqs. 54-55), then pass A on the start lists.
             let dt = sim.nominal_dt();
-            let mut probe = sim.state.clone();
-            let Fluid { u, u_hat, .. } = &mut probe.fluid;
-            let r = &probe.rates;
+            let (mut probe, mut r) = (sim.fluid().clone(), sim.fluid_rates().clone());
+            let Fluid { u, u_hat, .. } = &mut probe;
             integrator::kick_transport(u, u_hat.as_deref_mut(), &r.du, &r.a_c, r.a_c_dt, dt);
-            let walls = sim.walls.as_ref();
-            sim.passes.update_density_and_pressure(
-                &mut probe.fluid,
-                &sim.neighbours,
-                walls,
-                &probe.scheme,
-                &mut probe.rates,
-                dt,
+            let list = &sim.couplings.fluid_fluid.list;
+            rates::density_and_pressure_rates(
+                &mut FluidPasses::new(),
+                &probe,
+                list,
+                sim.boundaries(),
+                &mut r,
             );
+            rates::update_density_and_pressure(&mut probe, &r, dt);
             sim.step(f64::INFINITY).unwrap();
             let bits = |f: &Fluid<2>| f.by_id(&f.p).iter().map(|p| p.to_bits()).collect::<Vec<_>>();
-            let same = bits(&probe.fluid) == bits(&sim.state.fluid);
+            let same = bits(&probe) == bits(sim.fluid());
             assert_eq!(same, at_start, "{rates_at:?}");
         }
     }
@@ -820,7 +1144,7 @@ mod tests {
                 if schedule == Schedule::Wavefront {
                     assert_eq!(sim.wave.tiles(), 4);
                 }
-                let (f, r) = (&sim.state.fluid, &sim.state.rates);
+                let (f, r) = (sim.fluid(), sim.fluid_rates());
                 let mut bits: Vec<u64> = f.p.iter().chain(&f.rho).map(|x| x.to_bits()).collect();
                 bits.extend(r.du.iter().chain(&f.u).flat_map(|v| v.iter().map(|c| c.to_bits())));
                 bits
@@ -859,8 +1183,7 @@ mod tests {
                     if let Some(tiles) = tiles {
                         assert_eq!(sim.wave.tiles(), tiles, "{scheme:?} {pst:?} {schedule:?}");
                     }
-                    let f = &sim.state.fluid;
-                    let r = &sim.state.rates;
+                    let (f, r) = (sim.fluid(), sim.fluid_rates());
                     let vectors = [&f.x, &f.u, &r.du, &r.a_c];
                     let mut bits: Vec<u64> =
                         [&f.rho, &f.p, &r.dp].iter().flat_map(|v| v.iter().map(|x| x.to_bits())).collect();

@@ -9,6 +9,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// One point-data array.
+#[derive(Clone, Debug)]
 pub enum Field<'a> {
     /// A scalar per particle.
     Scalar(&'a str, Vec<f64>),
@@ -16,6 +17,17 @@ pub enum Field<'a> {
     Vector(&'a str, Vec<[f64; 3]>),
     /// An integer per particle.
     Int(&'a str, Vec<i64>),
+}
+
+impl Field<'_> {
+    /// The field of the particles `keep` only, in that order.
+    pub fn select(&self, keep: &[usize]) -> Self {
+        match self {
+            Field::Scalar(n, v) => Field::Scalar(n, keep.iter().map(|&k| v[k]).collect()),
+            Field::Vector(n, v) => Field::Vector(n, keep.iter().map(|&k| v[k]).collect()),
+            Field::Int(n, v) => Field::Int(n, keep.iter().map(|&k| v[k]).collect()),
+        }
+    }
 }
 
 /// Writes one snapshot.

@@ -1,26 +1,17 @@
-//! Schemes: named compositions of the term functions in `equations`, as ordered passes.
+//! What a scheme is: named compositions of the term functions in `equations`.
 //!
 //! A scheme is a [`FluidScheme`] value: what the density, pressure, pressure gradient,
-//! viscosity and transport velocity are. `edac`, `tvf` and `ctvf` are three values of it
-//! ([`SchemeName::fluid_scheme`]), not three code paths; "with and without corrections" is
-//! the [`Corrections`] field. [`Display`](std::fmt::Display) prints the plan, written at the
-//! top of every run log.
+//! viscosity and transport velocity of a fluid body are. `edac`, `tvf` and `ctvf` are three
+//! values of it ([`SchemeName::fluid_scheme`]), not three code paths; "with and without
+//! corrections" is the [`Corrections`] field. [`settings`] turns what a scene gives (typed,
+//! with every option checked against the scheme that reads it) into such a value; [`plan`]
+//! turns it into the bits of the terms the passes evaluate. [`Display`](std::fmt::Display)
+//! prints the scheme, written at the top of every run log.
 
-mod free_surface;
-mod ipst;
-mod passes;
-mod plan;
-mod stages;
-mod walls;
-mod wavefront;
+pub mod plan;
+pub mod settings;
 
-pub use free_surface::SurfaceFields;
-pub use ipst::ipst_chi_reference;
-pub use passes::{build_kernel_list, build_kernel_list_summing_density, FluidPasses, KernelList};
-pub use walls::WallSet;
-pub use wavefront::{
-    applies as wavefront_applies, Schedule, StageTimes, StepBodies, Tuner, Wavefront, TUNING_STEPS,
-};
+pub use settings::{FluidSettings, OptionError, SchemeOptions};
 
 use serde::{Deserialize, Serialize};
 use std::fmt;
@@ -290,11 +281,17 @@ pub mod paper {
 pub struct FluidScheme {
     /// The scheme this value was built for (for logs and summaries).
     pub name: SchemeName,
+    /// Speed of sound c_0: the acoustic limit of the time step (eq. 61) and the bound of a
+    /// blow-up.
+    pub c0: f64,
+    /// Reference speed U: the acoustic limit takes max(U, max |u|).
+    pub u_ref: f64,
     /// Density model.
     pub density: DensityModel,
     /// Pressure model.
     pub pressure: PressureModel,
-    /// Pressure-gradient form, with its reference resolved by [`set_walls`](Self::set_walls).
+    /// Pressure-gradient form, with its reference resolved by
+    /// [`resolve_reference`](Self::resolve_reference).
     pub pressure_gradient: PressureGradient,
     /// The reference pressure asked for (`Auto` resolves by the fluid's boundaries).
     #[serde(default)]
@@ -311,170 +308,29 @@ pub struct FluidScheme {
     pub free_surface: Option<FreeSurface>,
 }
 
-/// What a scene gives a scheme name to build a [`FluidScheme`] from.
-#[derive(Clone, Copy, Debug)]
-pub struct FluidSettings {
-    /// Reference density rho_0.
-    pub rho0: f64,
-    /// Speed of sound c_0.
-    pub c0: f64,
-    /// Reference (maximum) velocity U.
-    pub u_ref: f64,
-    /// Smoothing length h.
-    pub h: f64,
-    /// W(dx) for the Sun 2019 shifting.
-    pub w_dx: f64,
-    /// Kinematic viscosity, if any.
-    pub nu: Option<f64>,
-    /// Artificial viscosity alpha, if any.
-    pub alpha: Option<f64>,
-    /// alpha_edac of eq. (24).
-    pub edac_alpha: f64,
-    /// Density model for CTVF (summation for internal flows, continuity with a free surface).
-    pub density: DensityModel,
-    /// Shifting technique for CTVF.
-    pub pst: Pst,
-    /// CTVF corrections.
-    pub corrections: Corrections,
-    /// IPST tolerance and iteration cap.
-    pub ipst_tol: f64,
-    /// IPST iteration cap.
-    pub ipst_max_iter: usize,
-    /// IPST on every this many steps.
-    pub ipst_interval: usize,
-    /// Gravity.
-    pub gravity: [f64; 3],
-    /// The reference pressure of the pressure gradient (`Auto` also depends on the walls,
-    /// which [`Simulation::new`](crate::solver::simulation::Simulation::new) resolves).
-    pub pressure_reference: PressureReference,
-    /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
-    pub free_surface: Option<SurfacePressure>,
-}
-
-impl FluidSettings {
-    /// A viscous internal flow (no free surface, no gravity) with the [`paper`]'s defaults:
-    /// summation density, Sun's shifting, every correction, and the scheme's own pressure
-    /// reference. `w_dx` is W(dx) for Sun's shifting, `nu` the
-    /// kinematic viscosity.
-    pub fn internal_flow(rho0: f64, c0: f64, u_ref: f64, h: f64, w_dx: f64, nu: f64) -> Self {
-        Self {
-            rho0,
-            c0,
-            u_ref,
-            h,
-            w_dx,
-            nu: Some(nu),
-            alpha: None,
-            edac_alpha: paper::EDAC_ALPHA,
-            density: DensityModel::Summation,
-            pst: Pst::Sun,
-            corrections: Corrections::ALL,
-            ipst_tol: paper::IPST_TOL,
-            ipst_max_iter: paper::IPST_MAX_ITER,
-            ipst_interval: paper::IPST_INTERVAL,
-            gravity: [0.0; 3],
-            pressure_reference: PressureReference::Auto,
-            free_surface: None,
-        }
-    }
-}
-
-impl SchemeName {
-    /// Whether the scheme subtracts the neighbours' mean pressure (BQL) under
-    /// `pressure_reference = auto`, for a fluid `bounded` by walls or a free surface. `edac`
-    /// does, as PySPH's EDACScheme; `tvf` does not. `ctvf` does only without boundaries (a
-    /// periodic box: the Taylor-Green vortex needs it), and follows eq. (27) as printed
-    /// otherwise (the lid-driven cavity needs that; see [`PressureReference`]).
-    pub fn bql_by_default(self, bounded: bool) -> bool {
-        match self {
-            SchemeName::Edac => true,
-            SchemeName::Tvf => false,
-            SchemeName::Ctvf => !bounded,
-        }
-    }
-
-    /// The composition this scheme name stands for, for a fluid without walls (see
-    /// [`FluidScheme::set_walls`]).
-    pub fn fluid_scheme(self, s: &FluidSettings) -> FluidScheme {
-        let artificial_viscosity = s.alpha.filter(|&a| a > 0.0).map(|a| (a, s.c0));
-        let edac = PressureModel::Edac {
-            cs: s.c0,
-            nu: crate::solver::equations::edac::nu_edac(s.edac_alpha, s.h, s.c0),
-        };
-        // Adami et al. (2013): p_b = rho0 c0^2, applied over half a step (eq. 55), as
-        // PySPH's TVF integrator does. PySPH's EDAC scheme integrates with a midpoint
-        // predictor-corrector whose final stage sets u~ = u + dt a_c, i.e. twice the
-        // homogenisation of eq. (55): in our kick-drift-kick that is p_b = 2 rho0 c0^2.
-        let background = |factor: f64| Transport {
-            shifting: Shifting::BackgroundPressure { pb: factor * s.rho0 * s.c0 * s.c0 },
-            corrections: Corrections::NONE,
-        };
-        let mut scheme = match self {
-            SchemeName::Edac => FluidScheme {
-                name: self,
-                density: DensityModel::Summation,
-                pressure: edac,
-                pressure_gradient: PressureGradient::Adami { bql: false },
-                pressure_reference: s.pressure_reference,
-                viscosity: s.nu,
-                artificial_viscosity,
-                transport: Some(background(2.0)),
-                gravity: s.gravity,
-                free_surface: None,
-            },
-            SchemeName::Tvf => FluidScheme {
-                name: self,
-                density: DensityModel::Summation,
-                pressure: PressureModel::StateEquation { c0: s.c0, rho0: s.rho0 },
-                pressure_gradient: PressureGradient::Adami { bql: false },
-                pressure_reference: s.pressure_reference,
-                viscosity: s.nu,
-                artificial_viscosity,
-                transport: Some(background(1.0)),
-                gravity: s.gravity,
-                free_surface: None,
-            },
-            SchemeName::Ctvf => {
-                let shifting = match s.pst {
-                    Pst::Sun => Some(Shifting::Sun2019 { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 }),
-                    Pst::Ipst => Some(Shifting::Ipst {
-                        u_max: s.u_ref,
-                        tol: s.ipst_tol,
-                        max_iter: s.ipst_max_iter,
-                        interval: s.ipst_interval,
-                        chi_ref: f64::NAN, // measured on the initial configuration
-                    }),
-                    Pst::None => None,
-                };
-                FluidScheme {
-                    name: self,
-                    density: s.density,
-                    pressure: edac,
-                    pressure_gradient: PressureGradient::Symmetric { bql: false },
-                    pressure_reference: s.pressure_reference,
-                    viscosity: s.nu,
-                    artificial_viscosity,
-                    transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
-                    gravity: s.gravity,
-                    free_surface: s.free_surface.map(|pressure| FreeSurface { rho0: s.rho0, pressure }),
-                }
-            }
-        };
-        scheme.set_walls(false);
-        scheme
-    }
-}
-
 impl FluidScheme {
-    /// Resolves the pressure reference for a fluid with (or without) walls:
-    /// [`Simulation::new`](crate::solver::simulation::Simulation::new) calls it with its wall
-    /// body, so that a scene declares its walls once, as a body.
-    pub fn set_walls(&mut self, walls: bool) {
-        let bounded = walls || self.free_surface.is_some();
+    /// Resolves the `Auto` pressure reference for a fluid with (or without) boundaries:
+    /// the simulation calls it once it knows the fluid's neighbours, so that a scene
+    /// declares its walls once, as bodies.
+    pub fn resolve_reference(&mut self, boundaries: bool) {
+        let bounded = boundaries || self.free_surface.is_some();
         let on = self.pressure_reference.bql(self.name.bql_by_default(bounded));
         match &mut self.pressure_gradient {
             PressureGradient::Symmetric { bql } | PressureGradient::Adami { bql } => *bql = on,
         }
+    }
+
+    /// Whether `other` declares the same physics (what a run measures into the scheme at its
+    /// start, IPST's chi_ref, aside).
+    pub fn same_physics(&self, other: &Self) -> bool {
+        let declared = |s: &Self| {
+            let mut s = *s;
+            if let Some(Transport { shifting: Shifting::Ipst { chi_ref, .. }, .. }) = s.transport.as_mut() {
+                *chi_ref = 0.0;
+            }
+            s
+        };
+        declared(self) == declared(other)
     }
 
     /// Gravity as a `D`-vector.
@@ -565,7 +421,7 @@ pub(crate) mod tests {
 
     fn bql(name: SchemeName, s: &FluidSettings, walls: bool) -> bool {
         let mut scheme = name.fluid_scheme(s);
-        scheme.set_walls(walls);
+        scheme.resolve_reference(walls);
         match scheme.pressure_gradient {
             PressureGradient::Symmetric { bql } | PressureGradient::Adami { bql } => bql,
         }

@@ -1,12 +1,13 @@
 //! The gather passes of a step as a wavefront over tiles of the sorted particles, so that
 //! a large body's neighbour list is still in cache when the passes read it.
 //!
-//! A step lists the neighbours (with the summation density), then evaluates the pressure
-//! rates (pass A), updates the pressure, and evaluates the accelerations (pass B): three
-//! sweeps over a list of about 0.8 kB a particle in 2D. Once the list outgrows the cache
-//! (160 000 particles make 130 MB), each sweep streams it from memory, and a particle-step
-//! cost 1.7 times as much at nx = 400 as at nx = 200 on a host whose cache held the smaller
-//! list (docs/throughput.md, session 35). Here the particles, in cell order, are cut into
+//! It is the fast path of a scene of one fluid body and nothing else. A step lists the
+//! neighbours (with the summation density), then evaluates the pressure rates (pass A),
+//! updates the pressure, and evaluates the accelerations (pass B): three sweeps over a list
+//! of about 0.8 kB a particle in 2D. Once the list outgrows the cache (160 000 particles
+//! make 130 MB), each sweep streams it from memory, and a particle-step cost 1.7 times as
+//! much at nx = 400 as at nx = 200 on a host whose cache held the smaller list. Here the
+//! particles, in cell order, are cut into
 //! tiles of whole list chunks, each wider than two cell layers, so that a particle's
 //! neighbours lie in its own tile or the next one on either side (cyclically). Each stage
 //! of a tile then needs only the previous stage done on the tile and its two neighbours,
@@ -15,7 +16,7 @@
 //! list are alive at a time. The tiles are the narrowest the reach allows: the less of the
 //! list is alive, the more of it stays in cache beside what else the step keeps there
 //! (IPST's work space: in `ctvf`+`ipst` at nx = 200, passes A and B ran 1.6x faster in
-//! such tiles than in sweeps on one thread, session 38). Once a tile's pass B has run its
+//! such tiles than in sweeps on one thread). Once a tile's pass B has run its
 //! payloads (the kernel values, 24 of a pair's 28 bytes) are dead, and their storage goes
 //! to the next tile listed, so that the listing writes into memory still in cache rather
 //! than into memory last touched a step ago: without that hand-over the wavefront took
@@ -31,20 +32,22 @@
 //! stage of a tile at a time, and waits for another only where a stage needs one of its
 //! tiles ([`Board`]). A stage forks no parallel loop: when each stage of each tile was one,
 //! their forks and joins (some eighty a step at nx = 200) made the narrow tiles 13 % slower
-//! than the sweeps on two threads (session 38). Which is faster, the sweeps or the
+//! than the sweeps on two threads. Which is faster, the sweeps or the
 //! wavefront, depends on the host's cache, the scheme and the threads, so by default a run
 //! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
 
-use super::passes::{
-    pressure_rates, set_and_regather, shifting_dt, write_accelerations, writes_homogenisation, FluidViews,
-    KernelAndDensity, RateTerms, Sources,
-};
 use super::stages::{run_stages, Grid, Tiled, WHOLE_TILE};
-use super::{DensityModel, FluidPasses, FluidScheme, KernelList, PressureModel, PressureReference};
 use crate::solver::equations::Point;
+use crate::solver::interactions::fluid_boundary::Boundaries;
+use crate::solver::interactions::fluid_fluid::{FluidFluid, RateTerms};
+use crate::solver::interactions::lists::{KernelAndDensity, KernelList};
 use crate::solver::kernel::Kernel;
 use crate::solver::nnps::{CellList, CHUNK};
-use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::passes::accelerations::{shifting_dt, write_accelerations, writes_homogenisation};
+use crate::solver::passes::rates::pressure_rates;
+use crate::solver::passes::{set_and_regather, FluidPasses, FluidViews, Sources};
+use crate::solver::scheme::{DensityModel, FluidScheme, PressureModel, PressureReference};
+use crate::solver::systems::{Fluid, FluidRates};
 use std::collections::VecDeque;
 use std::ops::Range;
 use std::time::Instant;
@@ -85,12 +88,12 @@ pub struct Wavefront {
     board: Board,
 }
 
-/// Whether a step of `scheme` (on a fluid with or without `walls`) can run as a wavefront:
-/// its passes are the listing with the summation density, pass A with the EDAC pressure
-/// only, and pass B, and nothing between them reads the whole body (walls, a free surface,
-/// a global mean pressure).
-pub fn applies(scheme: &FluidScheme, walls: bool) -> bool {
-    !walls
+/// Whether a step of a fluid of `scheme` can run as a wavefront, `alone` in its scene (no
+/// other body): its passes are the listing with the summation density, pass A with the
+/// EDAC pressure only, and pass B, and nothing between them reads the whole body (another
+/// body, a free surface, a global mean pressure).
+pub fn applies(scheme: &FluidScheme, alone: bool) -> bool {
+    alone
         && scheme.free_surface.is_none()
         && scheme.density == DensityModel::Summation
         && matches!(scheme.pressure, PressureModel::Edac { .. })
@@ -177,148 +180,18 @@ impl Wavefront {
     }
 }
 
-/// How a step's gather passes are ordered; the results are the same bit for bit.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Schedule {
-    /// The fastest of the others on this host, timed over the first steps ([`Tuner`]).
-    #[default]
-    Tuned,
-    /// Each pass over the whole body, one after the other.
-    Sweeps,
-    /// Tile by tile where the scheme and the body allow ([`Wavefront`]), else sweeps.
-    Wavefront,
-}
-
-/// Steps a [`Tuner`] runs a schedule for in a row (`BLOCK`), and how many of the first of
-/// them it does not time (`SETTLE`): a schedule pays for its predecessor's state for two
-/// or three steps after a change. On the host of session 38, at nx = 200 on two threads,
-/// `edac`'s first steps in tiles after sweeps ran 10-20 % faster than the ones after them,
-/// and the sweeps' first steps after tiles 10-20 % slower: timed step by step in
-/// alternation, the tiles looked faster than the sweeps, and ran 13 % slower when kept.
-const BLOCK: usize = 6;
-const SETTLE: usize = 3;
-/// Blocks of each schedule before the tuner keeps one, in turn, so that a slow spell of the
-/// host does not fall on one schedule alone.
-const ROUNDS: usize = 3;
-
-/// How much faster than the wavefront the sweeps must have run for the tuner to keep them.
-/// The tiles keep a step's lists in cache, so they lose less than the sweeps to whatever
-/// runs between and around the passes: after a pause as long as IPST's sweeps, the listing
-/// and passes took 4-6 % longer in tiles and 6-17 % in sweeps (nx = 200, one thread), and where
-/// `edac` at nx = 200 on two threads ran within 3 % in either order alone, the sweeps ran
-/// 338 ns a particle-step against 297 for the tiles when stepped side by side with other
-/// runs (`bench --interleave`; session 40).
-const SWEEPS_MARGIN: f64 = 0.03;
-
-/// Steps the tuner takes at most before it keeps a schedule: a block of sweeps untimed (a
-/// run's first steps, which fault its memory in, took up to three times as long as the
-/// later ones), then `ROUNDS` blocks of the sweeps and of the wavefront.
-pub const TUNING_STEPS: usize = (1 + 2 * ROUNDS) * BLOCK;
-
-/// Picks the faster of the sweeps and the wavefront for a body. Which one
-/// is faster is a property of the host and the scheme: on the host of session 35 the
-/// wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
-/// the list still fitted its cache; on hosts whose memory kept up with the sweeps, only
-/// its cost would show. The first steps go round the candidates in blocks of `BLOCK`
-/// steps, `ROUNDS` times, then the one with the shortest median timed step (of the last
-/// `BLOCK - SETTLE` steps of each block) is kept, the wavefront unless the sweeps beat it by
-/// more than `SWEEPS_MARGIN`.
-/// Each gives the same results, so the choice changes only the speed.
-#[derive(Clone, Debug, Default)]
-pub struct Tuner {
-    /// The schedules timed, sweeps first: empty until the body first makes tiles.
-    candidates: Vec<Schedule>,
-    /// Seconds of each candidate's timed steps.
-    seconds: Vec<Vec<f64>>,
-    /// Steps recorded so far.
-    steps: usize,
-    chosen: Option<Schedule>,
-}
-
-impl Tuner {
-    /// Whether the candidates are still to be offered.
-    pub fn needs_candidates(&self) -> bool {
-        self.candidates.is_empty()
-    }
-
-    /// The schedules to time, once (later offers are ignored).
-    pub fn offer(&mut self, candidates: Vec<Schedule>) {
-        if self.candidates.is_empty() {
-            self.seconds = vec![Vec::with_capacity(ROUNDS * (BLOCK - SETTLE)); candidates.len()];
-            self.candidates = candidates;
-        }
-    }
-
-    /// The schedule of the next step: the one kept, else the one whose block it is (the
-    /// sweeps in the first, untimed block); sweeps without candidates.
-    pub fn next(&self) -> Schedule {
-        match (self.chosen, self.turn()) {
-            (Some(kept), _) => kept,
-            (None, Some(k)) => self.candidates[k],
-            (None, None) => Schedule::Sweeps,
-        }
-    }
-
-    /// The candidate whose block the next step is in, if it is not the first block.
-    fn turn(&self) -> Option<usize> {
-        (self.steps / BLOCK).checked_sub(1).and_then(|b| b.checked_rem(self.candidates.len()))
-    }
-
-    /// The schedule kept, once the trials are done.
-    pub fn chosen(&self) -> Option<Schedule> {
-        self.chosen
-    }
-
-    /// Records a step that took `seconds` under `schedule` (ignored unless it is
-    /// [`next`](Self::next)'s, while the trials last).
-    pub fn record(&mut self, schedule: Schedule, seconds: f64) {
-        if self.chosen.is_some() || self.candidates.is_empty() || schedule != self.next() {
-            return;
-        }
-        if let Some(k) = self.turn() {
-            if self.steps % BLOCK >= SETTLE {
-                self.seconds[k].push(seconds);
-            }
-        }
-        self.steps += 1;
-        if self.steps == (1 + ROUNDS * self.candidates.len()) * BLOCK {
-            // In place: the step allocates nothing.
-            let median = |t: &mut [f64]| {
-                t.sort_by(f64::total_cmp);
-                (t[(t.len() - 1) / 2] + t[t.len() / 2]) / 2.0
-            };
-            let (mut best, mut tiles) = (None::<(Schedule, f64)>, None);
-            for (k, &schedule) in self.candidates.iter().enumerate() {
-                let m = median(&mut self.seconds[k]);
-                if best.is_none_or(|b| m < b.1) {
-                    best = Some((schedule, m));
-                }
-                if schedule == Schedule::Wavefront {
-                    tiles = Some(m);
-                }
-            }
-            self.chosen = match (best, tiles) {
-                (Some((_, b)), Some(t)) if t <= b * (1.0 + SWEEPS_MARGIN) => Some(Schedule::Wavefront),
-                (b, _) => b.map(|b| b.0),
-            };
-        }
-    }
-}
-
 /// What a wavefront step reads and writes.
 pub struct StepBodies<'a, const D: usize> {
-    /// The fluid, sorted by cell and binned in `cells`.
+    /// The fluid, sorted by cell and binned in `cells` (its scheme [`applies`]).
     pub fluid: &'a mut Fluid<D>,
     /// Its binning.
     pub cells: &'a CellList<D>,
     /// The smoothing kernel.
     pub kernel: &'a Kernel,
-    /// Its neighbour list, rebuilt tile by tile.
-    pub list: &'a mut KernelList<D>,
-    /// The fluid's share of the summation density.
-    pub fluid_density: &'a mut Vec<f64>,
-    /// The scheme ([`applies`] to it).
-    pub scheme: &'a FluidScheme,
+    /// Its neighbour list, rebuilt tile by tile, with its share of the summation density.
+    pub own: &'a mut FluidFluid<D>,
+    /// The passes' gathered views.
+    pub passes: &'a mut FluidPasses<D>,
     /// The rates the passes write.
     pub rates: &'a mut FluidRates<D>,
 }
@@ -440,28 +313,27 @@ impl super::stages::Board for Board {
     }
 }
 
-impl<const D: usize> FluidPasses<D> {
+impl Wavefront {
     /// The listing, summation density, pass A with the pressure update over `dt`, and pass B
     /// (whose shifting is scaled for `dt_accel`) of a step, tile by tile as `wave` plans
     /// them ([`Wavefront::plan`] must have returned true for these particles). The threads
     /// of the pool each take whole stages of tiles whose inputs are done, so that a stage
     /// forks nothing and threads wait for each other only where the dependencies make them.
-    pub fn wavefront_step(
-        &mut self,
-        wave: &mut Wavefront,
-        b: StepBodies<'_, D>,
-        dt: f64,
-        dt_accel: f64,
-    ) -> StageTimes {
+    pub fn step<const D: usize>(&mut self, b: StepBodies<'_, D>, dt: f64, dt_accel: f64) -> StageTimes {
         let clock = Instant::now();
-        let StepBodies { fluid, cells, kernel, list, fluid_density, scheme, rates } = b;
+        let StepBodies { fluid, cells, kernel, own, passes, rates } = b;
+        let FluidFluid { list, density: fluid_density } = own;
         let n = fluid.len();
         list.begin(cells, n);
         fluid_density.resize(n, 0.0);
-        self.points.resize(n, Point::new(fluid.u[0], fluid.u_hat()[0], fluid.m[0], fluid.rho[0], fluid.p[0]));
-        rates.a_c_dt = shifting_dt(scheme, dt_accel);
-        let terms = RateTerms::new(scheme);
-        let writes_ac = writes_homogenisation(scheme);
+        passes
+            .points
+            .resize(n, Point::new(fluid.u[0], fluid.u_hat()[0], fluid.m[0], fluid.rho[0], fluid.p[0]));
+        let scheme = fluid.physics;
+        rates.a_c_dt = shifting_dt(&scheme, dt_accel);
+        let terms = RateTerms::new(&scheme);
+        let writes_ac = writes_homogenisation(&scheme);
+        let wave = self;
         let mut board = std::mem::take(&mut wave.board);
         board.reset(&wave.bounds, rayon::current_num_threads());
 
@@ -472,14 +344,14 @@ impl<const D: usize> FluidPasses<D> {
         // views through `Tiled::gather`, the list chunk by chunk), never through a reference
         // to a whole array, whose making would read the elements other threads write.
         let (rho, p) = (Tiled::new(&mut fluid.rho), Tiled::new(&mut fluid.p));
-        let points = Tiled::new(&mut self.points);
+        let points = Tiled::new(&mut passes.points);
         let density = Tiled::new(fluid_density);
         let (dp, du) = (Tiled::new(&mut rates.dp), Tiled::new(&mut rates.du));
         let a_c = Tiled::new(if writes_ac { &mut rates.a_c[..] } else { &mut [] });
         let writer = list.chunk_writer();
         let (fluid, list, tiles): (&Fluid<D>, &KernelList<D>, &Wavefront) = (fluid, list, wave);
         let views = FluidViews::of(fluid);
-        let listing = KernelAndDensity::new(fluid, kernel);
+        let listing = KernelAndDensity::new(&fluid.m, fluid.h, kernel);
         let chunks_of = |k: usize| tiles.range(k).start / CHUNK..tiles.range(k).end.div_ceil(CHUNK);
         let run = |task: Task| {
             let (k, r) = (task.tile, tiles.range(task.tile));
@@ -509,7 +381,7 @@ impl<const D: usize> FluidPasses<D> {
                     set_and_regather(views, r.start, own, |i, rho, _| *rho = rho_k[i - r.start], WHOLE_TILE);
                 },
                 Stage::Rates => unsafe {
-                    let src = Sources::fluid_only(fluid, list, points.gather());
+                    let src = Sources::new(fluid, list, points.gather(), Boundaries::none());
                     pressure_rates(&terms, &src, r.start, dp.run(r.clone()), WHOLE_TILE);
                 },
                 Stage::Update => unsafe {
@@ -519,13 +391,12 @@ impl<const D: usize> FluidPasses<D> {
                     set_and_regather(views, r.start, own, |i, _, p| *p += dt * dp_k[i - r.start], WHOLE_TILE);
                 },
                 Stage::Accelerations => unsafe {
-                    let src = Sources::fluid_only(fluid, list, points.gather());
+                    let src = Sources::new(fluid, list, points.gather(), Boundaries::none());
                     let a_c = if writes_ac { a_c.run(r.clone()) } else { &mut [] };
                     write_accelerations(
                         &src,
                         fluid,
                         None,
-                        scheme,
                         dt_accel,
                         r.start,
                         du.run(r.clone()),
@@ -662,70 +533,5 @@ mod tests {
             }
         }
         assert!(planned >= 9 && refused >= 3, "the test needs bodies that make tiles ({planned}, {refused})");
-    }
-
-    /// The tuner runs a block of sweeps untimed, then goes round its candidates in blocks,
-    /// sweeps first, leaving each block's first steps untimed, and keeps the one with the
-    /// shortest median timed step (the tiles, unless the sweeps beat them by more than
-    /// `SWEEPS_MARGIN`): neither a change's transient nor one slow step decides.
-    /// Without candidates it runs the sweeps and keeps nothing.
-    #[test]
-    fn the_tuner_keeps_the_schedule_with_the_shortest_median_settled_step() {
-        let tiles = Schedule::Wavefront;
-        let tune = |tiles_settled: f64| {
-            let mut t = Tuner::default();
-            assert!(t.needs_candidates());
-            assert_eq!(t.next(), Schedule::Sweeps);
-            t.record(Schedule::Sweeps, 1.0);
-            assert_eq!(t.chosen(), None, "nothing timed without candidates");
-            t.offer(vec![Schedule::Sweeps, tiles]);
-            assert!(!t.needs_candidates());
-            let (mut order, mut at) = (Vec::new(), 0);
-            while t.chosen().is_none() {
-                let s = t.next();
-                // The step's place in its block: the transient of a change lasts SETTLE steps.
-                let settled =
-                    order.last() == Some(&s) && order.iter().rev().take_while(|&&o| o == s).count() >= SETTLE;
-                let seconds = match s {
-                    _ if at < BLOCK => 5.0, // the run's first steps
-                    Schedule::Sweeps if settled => 1.0,
-                    Schedule::Sweeps => 3.0,
-                    _ if !settled => 0.1,
-                    // one slow step, the tiles' first settled one
-                    _ if order.iter().filter(|&&o| o == tiles).count() == SETTLE => 9.0,
-                    _ => tiles_settled,
-                };
-                t.record(s, seconds);
-                order.push(s);
-                at += 1;
-            }
-            let mut expected = vec![Schedule::Sweeps; BLOCK];
-            for _ in 0..ROUNDS {
-                for s in [Schedule::Sweeps, tiles] {
-                    expected.extend([s; BLOCK]);
-                }
-            }
-            assert_eq!(order, expected);
-            assert_eq!(order.len(), TUNING_STEPS);
-            t
-        };
-        let mut t = tune(1.1);
-        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "the tiles' fast first steps do not decide");
-        // Sweeps faster by less than the margin: the tiles, which lose less to the host.
-        assert_eq!(tune(1.0 + SWEEPS_MARGIN / 2.0).chosen(), Some(tiles), "within the margin");
-        let t2 = tune(0.9);
-        assert_eq!(t2.chosen(), Some(tiles), "one slow step does not decide");
-        assert_eq!(t2.next(), tiles);
-        t.record(tiles, 0.01);
-        t.offer(vec![tiles]);
-        assert_eq!(t.chosen(), Some(Schedule::Sweeps), "kept once chosen");
-        let mut slow = Tuner::default();
-        slow.offer(vec![Schedule::Sweeps, tiles]);
-        while slow.chosen().is_none() {
-            slow.record(Schedule::Tuned, 0.1);
-            let s = slow.next();
-            slow.record(s, if s == tiles { 1.2 } else { 1.0 });
-        }
-        assert_eq!(slow.chosen(), Some(Schedule::Sweeps), "only the schedule run counts");
     }
 }

@@ -6,19 +6,24 @@
 //! geometry ([`Slabs`]), so that its sums, too, do not depend on the thread count.
 //!
 //! The sweeps and moves of all the iterations run as stages of the slabs on the threads of
-//! the pool ([`stages`](super::stages)), a slab's next sweep starting once the slabs around
-//! it have moved, rather than as two parallel loops a sweep: at nx = 100 on two threads
-//! each loop lost some 20 microseconds to its join, and the moves took 1.5x their one-thread
-//! time, about a tenth of IPST's time in all (docs/throughput.md, session 40).
+//! the pool ([`stages`](crate::solver::schedule::stages)), a slab's next sweep starting once
+//! the slabs around it have moved, rather than as two parallel loops a sweep: on two
+//! threads each loop lost some 20 microseconds to its join, and the moves took 1.5x their
+//! one-thread time, about a tenth of IPST's time in all.
+//!
+//! IPST reads a body's positions and volumes and its boundaries, so that any body kind
+//! that shifts its particles can use it.
 
-use super::passes::{FluidPasses, KernelList, MIN_LEN};
-use super::stages::{run_stages, Board, Grid, Tiled};
-use super::{FluidScheme, Shifting, SurfaceFields, WallSet};
-use crate::solver::equations::{free_surface, shifting};
+use super::free_surface::SurfaceFields;
+use super::MIN_LEN;
+use crate::solver::equations::{free_surface, shifting, Point};
+use crate::solver::interactions::fluid_boundary::Boundaries;
+use crate::solver::interactions::lists::KernelList;
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Gather, HalfPairs, PairSlices, Slabs};
-use crate::solver::particles::{Fluid, FluidRates};
+use crate::solver::schedule::stages::{run_stages, Board, Grid, Tiled};
+use crate::solver::scheme::Shifting;
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -27,85 +32,102 @@ use std::sync::{Mutex, PoisonError};
 /// IPST's work space, kept from step to step (it grows on first use, in scenes that
 /// declare IPST only).
 #[derive(Debug, Default)]
-pub(super) struct IpstWork<const D: usize> {
+pub struct Ipst<const D: usize> {
     /// The moved positions: sweep m reads `x[m % 2]` and moves them into the other.
     x: [Vec<Vector<D>>; 2],
     slabs: Slabs,
     slab_work: Vec<Mutex<IpstSlab<D>>>,
     /// Each particle's sum `sum V_b n_ab W_ab`.
     sums: Vec<Vector<D>>,
-    /// The fluid's and the walls' volumes, as compact arrays.
+    /// The body's and each boundary's volumes, as compact arrays.
     vol: Vec<f64>,
-    wall_vol: Vec<f64>,
+    boundary_vol: Vec<Vec<f64>>,
     /// Which sweeps and moves are done on each slab.
     board: SweepBoard,
     witness: Mutex<Witness>,
 }
 
-impl<const D: usize> FluidPasses<D> {
+/// What IPST moves: a body's positions `x` (binned by `cells` in their current order, listed
+/// in `nl`, smoothing length `h`), its particles' views `points` (whose volumes it reads),
+/// and its boundaries.
+#[derive(Clone, Copy)]
+pub struct Shifted<'a, const D: usize> {
+    /// Positions.
+    pub x: &'a [Vector<D>],
+    /// The particles' views as the passes last gathered them.
+    pub points: &'a [Point<D>],
+    /// Smoothing length.
+    pub h: f64,
+    /// The body's neighbour list.
+    pub nl: &'a KernelList<D>,
+    /// Its binning.
+    pub cells: &'a CellList<D>,
+    /// Its boundaries, fixed neighbours of the moves.
+    pub boundaries: Boundaries<'a, D>,
+}
+
+impl<const D: usize> Ipst<D> {
     /// IPST (eqs. 37-41): move copies of the particles by `U_max dt sum V_b n_ab W_ab` until
     /// `|max chi - chi_ref| <= tol chi_ref` (eq. 39, chi of eq. 40) or `max_iter` moves,
-    /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41), on steps whose index `step` is a
-    /// multiple of the scheme's interval (every step by default, as the paper says), with
-    /// `(du/dt)_c = 0` on the others. The particles themselves are not
-    /// moved: the kick of the next step applies the displacement through u~. Walls are
+    /// then set `(du/dt)_c = 2 (r^M - r^0) / dt^2` (eq. 41) into `a_c`, on steps whose index
+    /// `step` is a multiple of the shifting's interval (every step by default, as the paper
+    /// says), with `(du/dt)_c = 0` on the others. The particles themselves are not moved:
+    /// the kick of the next step applies the displacement through u~. The boundaries are
     /// fixed neighbours.
     ///
     /// The iterations reuse the step's neighbour lists with the kernel re-evaluated at the
     /// moved positions. The moves are a small fraction of dx, so the only pairs this misses
     /// are those entering the support from outside it during the iterations, whose kernel
     /// value is of the fifth order in the distance they moved in (quintic spline).
-    /// Each fluid pair is evaluated once a sweep and adds to both particles (`W_ab` and
-    /// `r_ab` are symmetric, `x_ba = -x_ab`), in the slabs of `cells` (see [`Slabs`]), so
+    /// Each pair of the body is evaluated once a sweep and adds to both particles (`W_ab`
+    /// and `r_ab` are symmetric, `x_ba = -x_ab`), in the slabs of `cells` (see [`Slabs`]), so
     /// that the sums do not depend on the thread count. chi is not summed in the sweeps:
-    /// the moves evaluate it, for a witness first ([`Witness`]). `cells` must have binned
-    /// the fluid in its current order. Returns the number of moves made.
+    /// the moves evaluate it, for a witness first ([`Witness`]). Returns the number of moves
+    /// made; nothing (0) unless `shifting` is IPST's.
     #[allow(clippy::too_many_arguments)]
-    pub fn ipst(
+    pub fn run(
         &mut self,
-        fluid: &Fluid<D>,
-        nl: &KernelList<D>,
-        cells: &CellList<D>,
-        walls: Option<&WallSet<D>>,
+        body: Shifted<'_, D>,
         surface: Option<&SurfaceFields<D>>,
         k: &Kernel,
-        s: &FluidScheme,
-        rates: &mut FluidRates<D>,
+        shifting: Option<Shifting>,
+        a_c: &mut [Vector<D>],
         dt: f64,
         step: u64,
     ) -> usize {
-        let w = &mut self.ipst;
-        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref }) =
-            s.transport.map(|t| t.shifting)
-        else {
+        let w = self;
+        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref }) = shifting else {
             return 0;
         };
         if !step.is_multiple_of(interval as u64) {
-            rates.a_c.par_iter_mut().with_min_len(MIN_LEN).for_each(|ac| *ac = Vector::zeros());
+            a_c.par_iter_mut().with_min_len(MIN_LEN).for_each(|ac| *ac = Vector::zeros());
             return 0;
         }
-        let k = k.scaled(fluid.h);
-        let n = fluid.len();
+        let Shifted { x: body_x, points, h, nl, cells, boundaries } = body;
+        let k = k.scaled(h);
+        let n = body_x.len();
         let [x0, x1] = &mut w.x;
         x0.clear();
-        x0.extend_from_slice(&fluid.x);
+        x0.extend_from_slice(body_x);
         x1.resize(n, Vector::zeros());
         w.sums.resize(n, Vector::zeros());
-        // The volumes gathered by `accelerations` at these positions, as compact arrays
-        // (the sweeps read nothing else of the neighbours).
+        // The volumes at these positions, as compact arrays (the sweeps read nothing else
+        // of the neighbours).
         w.vol.resize(n, 0.0);
-        let pts = &self.points;
-        w.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = pts[i].v());
-        w.wall_vol.clear();
-        w.wall_vol.extend(self.wall_div.iter().map(|p| p.v()));
+        w.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = points[i].v());
+        w.boundary_vol.resize_with(boundaries.iter().count(), Vec::new);
+        for (vol, b) in w.boundary_vol.iter_mut().zip(boundaries.iter()) {
+            vol.clear();
+            vol.extend(b.model.div.iter().map(|p| p.v()));
+        }
         w.slabs.partition(cells, IPST_SLAB, IPST_SLAB_LAYERS);
         w.slab_work.resize_with(w.slabs.len(), Default::default);
-        let (vol, wall_vol, slabs) = (&w.vol, &w.wall_vol, &w.slabs);
+        let (vol, slabs) = (&w.vol, &w.slabs);
         w.slab_work.par_iter_mut().enumerate().for_each(|(t, slab)| {
             let slab = slab.get_mut().unwrap_or_else(PoisonError::into_inner);
             nl.half_pairs(slabs.range(t), &mut slab.half);
         });
-        let walls = walls.map(|ws| (ws, &wall_vol[..]));
+        let walls = BoundaryVolumes { boundaries, vol: &w.boundary_vol };
         let test = Convergence { chi_ref, tol };
         let mut board = std::mem::take(&mut w.board);
         let witness = w.witness.get_mut().unwrap_or_else(PoisonError::into_inner);
@@ -154,7 +176,7 @@ impl<const D: usize> FluidPasses<D> {
                 let to = unsafe { x[(m + 1) % 2].run(range.clone()) };
                 move_slab(range.clone(), sums, from, to, surface, u_max * dt);
                 let xs = unsafe { x[m % 2].read(0..n) };
-                let chi = |i: usize| chi_at(i, xs, nl, walls.map(|(ws, _)| ws), &k);
+                let chi = |i: usize| chi_at(i, xs, nl, boundaries, &k);
                 Witness::bound(witness, task.sweep, range, chi, &test)
             }
         };
@@ -162,8 +184,8 @@ impl<const D: usize> FluidPasses<D> {
         let iterations = board.iterations();
         w.board = board;
         let f = 2.0 / (dt * dt);
-        let (x0, xs) = (&fluid.x, &w.x[iterations % 2]);
-        rates.a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
+        let (x0, xs) = (body_x, &w.x[iterations % 2]);
+        a_c.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, ac)| {
             *ac = (xs[i] - x0[i]) * f;
         });
         iterations
@@ -200,22 +222,41 @@ fn move_slab<const D: usize>(
     }
 }
 
-/// chi of eq. (40) of particle `i` at positions `xs`: `h^2 sum_b W_ab` over its fluid
-/// neighbours (itself included) in the order of the list, then over the walls.
+/// chi of eq. (40) of particle `i` at positions `xs`: `h^2 sum_b W_ab` over its
+/// neighbours in the body (itself included) in the order of the list, then over each
+/// boundary's.
 fn chi_at<const D: usize>(
     i: usize,
     xs: &[Vector<D>],
     nl: &KernelList<D>,
-    walls: Option<&WallSet<D>>,
+    boundaries: Boundaries<'_, D>,
     k: &ScaledKernel,
 ) -> f64 {
     let mut chi = 0.0;
     let mut add = |_, xij: Vector<D>| chi += shifting::ipst_chi(k.h, k.w(xij.norm_squared().sqrt()));
     nl.for_each_difference(i, xs[i], xs, &mut add);
-    if let Some(ws) = walls {
-        ws.fluid_to_wall.for_each_difference(i, xs[i], &ws.wall.x, add);
+    for b in boundaries.iter() {
+        b.list.for_each_difference(i, xs[i], b.x, &mut add);
     }
     chi
+}
+
+/// The boundaries of a body IPST shifts, with their volumes as compact arrays.
+#[derive(Clone, Copy)]
+struct BoundaryVolumes<'a, const D: usize> {
+    boundaries: Boundaries<'a, D>,
+    vol: &'a [Vec<f64>],
+}
+
+impl<'a, const D: usize> BoundaryVolumes<'a, D> {
+    /// Each boundary with its volumes, in order.
+    #[inline(always)]
+    fn iter(
+        &self,
+    ) -> impl Iterator<Item = (crate::solver::interactions::fluid_boundary::BoundarySource<'a, D>, &'a [f64])> + 'a
+    {
+        self.boundaries.iter().zip(self.vol.iter().map(|v| &v[..]))
+    }
 }
 
 /// The particle whose chi a sweep's test (eq. 39) takes first: once the flow has developed,
@@ -442,7 +483,7 @@ impl<const D: usize> IpstSlab<D> {
         xs: Gather<'_, Vector<D>>,
         nl: &KernelList<D>,
         vol: &[f64],
-        walls: Option<(&WallSet<D>, &[f64])>,
+        walls: BoundaryVolumes<'_, D>,
         k: &ScaledKernel,
     ) {
         sums.fill(Vector::zeros());
@@ -500,19 +541,19 @@ struct IpstPairs<const D: usize> {
 }
 
 impl<const D: usize> IpstPairs<D> {
-    /// Evaluates the pairs of `particles` at positions `xs` over the fluid (the pairs
-    /// `j > i` only) and the walls (with their volumes).
+    /// Evaluates the pairs of `particles` at positions `xs` over the body (the pairs
+    /// `j > i` only) and the boundaries (with their volumes).
     fn evaluate(
         &mut self,
         particles: std::ops::Range<usize>,
         xs: Gather<'_, Vector<D>>,
         nl: &KernelList<D>,
         half: &HalfPairs,
-        walls: Option<(&WallSet<D>, &[f64])>,
+        walls: BoundaryVolumes<'_, D>,
         k: &ScaledKernel,
     ) {
-        let to_wall = walls.map(|(ws, _)| &ws.fluid_to_wall);
-        let n: usize = particles.clone().map(|i| half.count(i) + to_wall.map_or(0, |l| l.count(i))).sum();
+        let wall_count = |i: usize| walls.iter().map(|(b, _)| b.list.count(i)).sum::<usize>();
+        let n: usize = particles.clone().map(|i| half.count(i) + wall_count(i)).sum();
         // Whole vectors for the batch loops (no scalar tail). The arrays only grow, so the
         // padding holds earlier (finite) values, which no sum reads.
         let room = n.next_multiple_of(LANES);
@@ -531,10 +572,10 @@ impl<const D: usize> IpstPairs<D> {
             let xi = *xs.get(i);
             at += nl.write_half_pairs(half, i, xi, xs, &mut self.xij[at..]);
             self.fluid_end.push(at);
-            if let Some((ws, wall_vol)) = walls {
+            for (b, wall_vol) in walls.iter() {
                 let out = PairSlices { xij: &mut self.xij[at..], value: &mut self.vol[at..] };
-                ws.fluid_to_wall.write_pairs(i, xi, &ws.wall.x, wall_vol, out);
-                at += ws.fluid_to_wall.count(i);
+                b.list.write_pairs(i, xi, b.x, wall_vol, out);
+                at += b.list.count(i);
             }
             self.end.push(at);
         }
@@ -555,18 +596,19 @@ impl<const D: usize> IpstPairs<D> {
     }
 }
 
-/// chi_ref of eq. (39): the mean of `chi = h^2 sum W` over the initial configuration for
-/// internal flows (the authors' internal-flow choice: a perturbed lattice has no single
-/// value), the maximum with a free surface (CTVF sec. 3.3.2).
+/// chi_ref of eq. (39): the mean of `chi = h^2 sum W` over the initial configuration of
+/// the particles `x` (smoothing length `h`, list `nl`, with their `boundaries`) for internal
+/// flows (the authors' internal-flow choice: a perturbed lattice has no single value), the
+/// maximum with a free surface (CTVF sec. 3.3.2).
 pub fn ipst_chi_reference<const D: usize>(
-    fluid: &Fluid<D>,
+    (x, h): (&[Vector<D>], f64),
     nl: &KernelList<D>,
-    walls: Option<&WallSet<D>>,
+    boundaries: Boundaries<'_, D>,
     k: &Kernel,
     free_surface: bool,
 ) -> f64 {
-    let k = k.scaled(fluid.h);
-    let chi: Vec<f64> = (0..fluid.len()).map(|i| chi_at(i, &fluid.x, nl, walls, &k)).collect();
+    let k = k.scaled(h);
+    let chi: Vec<f64> = (0..x.len()).map(|i| chi_at(i, x, nl, boundaries, &k)).collect();
     if free_surface {
         chi.iter().fold(f64::MIN, |m, &v| m.max(v))
     } else {
@@ -576,10 +618,12 @@ pub fn ipst_chi_reference<const D: usize>(
 
 #[cfg(test)]
 mod tests {
-    use super::super::stages::take_turns;
     use super::*;
-    use crate::solver::scheme::passes::build_kernel_list;
-    use crate::solver::scheme::{FluidSettings, Pst, SchemeName};
+    use crate::solver::interactions::lists::build_kernel_list;
+    use crate::solver::passes::{accelerations, FluidPasses};
+    use crate::solver::schedule::stages::take_turns;
+    use crate::solver::scheme::{FluidScheme, FluidSettings, Pst, SchemeName};
+    use crate::solver::systems::{Fluid, FluidInit, FluidRates};
 
     /// IPST's board runs each sweep and each move of every slab once, after its inputs:
     /// a sweep after the moves before it on its slab and both next to it, moves after the
@@ -637,7 +681,6 @@ mod tests {
     fn perturbed_lattice(n: usize) -> (Fluid<2>, CellList<2>, KernelList<2>, Kernel) {
         use crate::solver::kernel::KernelKind;
         use crate::solver::nnps::Domain;
-        use crate::solver::particles::FluidInit;
         let dx = 1.0 / n as f64;
         let wave = |k: usize, s: f64| (s * (k as f64 + 1.0)).sin();
         let x: Vec<Vector<2>> = (0..n * n)
@@ -653,14 +696,15 @@ mod tests {
             p: vec![0.0; n * n],
             x,
         };
-        let mut fluid = Fluid::new("f", dx, init, true).unwrap();
+        let physics = SchemeName::Ctvf.fluid_scheme(&crate::solver::scheme::tests::internal_flow_settings());
+        let mut fluid = Fluid::new("f", dx, init, physics).unwrap();
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
         let mut cells = CellList::new(Domain::periodic([0.0; 2], [1.0; 2]), kernel.support() * dx);
         cells.update(&fluid.x);
         fluid.reorder(cells.order());
         cells.mark_reordered();
         let mut nl = KernelList::new();
-        build_kernel_list(&mut nl, &cells, &fluid, &kernel);
+        build_kernel_list(&mut nl, &cells, &fluid.x, fluid.h, &kernel);
         (fluid, cells, nl, kernel)
     }
 
@@ -674,11 +718,22 @@ mod tests {
     ) -> (usize, Vec<Vector<2>>, usize) {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
         pool.install(|| {
-            let (mut passes, mut rates) =
-                (FluidPasses::new(), FluidRates::new(fluid.len(), true, false, true));
-            passes.accelerations(fluid, nl, None, None, scheme, &mut rates, dt);
-            let moves = passes.ipst(fluid, nl, cells, None, None, kernel, scheme, &mut rates, dt, 0);
-            (moves, rates.a_c, passes.ipst.slabs.len())
+            let mut fluid = fluid.clone();
+            fluid.physics = *scheme;
+            let (mut passes, mut rates, mut ipst) =
+                (FluidPasses::new(), FluidRates::of(&fluid), Ipst::default());
+            accelerations::accelerations(&mut passes, &fluid, nl, Boundaries::none(), None, &mut rates, dt);
+            let body = Shifted {
+                x: &fluid.x,
+                points: &passes.points,
+                h: fluid.h,
+                nl,
+                cells,
+                boundaries: Boundaries::none(),
+            };
+            let shifting = scheme.transport.map(|t| t.shifting);
+            let moves = ipst.run(body, None, kernel, shifting, &mut rates.a_c, dt, 0);
+            (moves, rates.a_c, ipst.slabs.len())
         })
     }
 
@@ -694,7 +749,7 @@ mod tests {
         let settings = FluidSettings {
             pst: Pst::Ipst,
             ipst_max_iter: 1,
-            ..super::super::tests::internal_flow_settings()
+            ..crate::solver::scheme::tests::internal_flow_settings()
         };
         let scheme = SchemeName::Ctvf.fluid_scheme(&settings);
         let Some(Shifting::Ipst { u_max, .. }) = scheme.transport.map(|t| t.shifting) else {
@@ -742,9 +797,9 @@ mod tests {
         let settings = FluidSettings {
             pst: Pst::Ipst,
             ipst_max_iter: max_iter,
-            ..super::super::tests::internal_flow_settings()
+            ..crate::solver::scheme::tests::internal_flow_settings()
         };
-        let chi_ref = ipst_chi_reference(&fluid, &nl, None, &kernel, false);
+        let chi_ref = ipst_chi_reference((&fluid.x, fluid.h), &nl, Boundaries::none(), &kernel, false);
         // The first move shifts particles by up to a ninth of dx, and chi's largest
         // excess falls from 17 % to 3 % over the ten.
         let dt = 0.005;

@@ -1,12 +1,13 @@
 //! Free-surface detection (CTVF sec. 3.4 and Algorithm 1): normals, surface particles and
-//! the particles next to them, recomputed every step for fluids that declare a free surface.
+//! the particles next to them, recomputed every step for bodies that declare a free surface.
 
-use super::passes::KernelList;
-use super::{SurfacePressure, WallSet};
+use super::Particles;
 use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal, smoothed_normal};
 use crate::solver::equations::Point;
+use crate::solver::interactions::fluid_boundary::Boundaries;
+use crate::solver::interactions::lists::KernelList;
 use crate::solver::math::Vector;
-use crate::solver::particles::Fluid;
+use crate::solver::scheme::SurfacePressure;
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 
@@ -14,7 +15,7 @@ use rayon::prelude::*;
 /// reference density is isolated, away from the bulk (sec. 3.4): a surface particle.
 const ISOLATED: f64 = 0.5;
 
-/// Per-particle free-surface state of one fluid.
+/// Per-particle free-surface state of one body.
 #[derive(Clone, Debug, Default)]
 pub struct SurfaceFields<const D: usize> {
     n_star: Vec<Vector<D>>,
@@ -28,35 +29,43 @@ pub struct SurfaceFields<const D: usize> {
     pub near: Vec<bool>,
 }
 
-fn fluid_point<const D: usize>(f: &Fluid<D>, j: usize) -> Point<D> {
-    Point::new(f.u[j], f.u[j], f.m[j], f.rho[j], f.p[j])
+/// Particle `j` of mass `m` and density `rho` as the normals read it (its volume).
+#[inline(always)]
+fn volume_point<const D: usize>(m: f64, rho: f64) -> Point<D> {
+    Point::new(Vector::zeros(), Vector::zeros(), m, rho, 0.0)
 }
 
 impl<const D: usize> SurfaceFields<D> {
-    /// Detects the surface of `fluid` (with walls as neighbours) whose reference density is
-    /// `rho0`: eq. (42) with its cut-off, eq. (43), the low-density rule (summation density
-    /// below rho0 / 2), the 60-degree test, and the neighbours of surface particles.
-    pub fn detect(&mut self, fluid: &Fluid<D>, nl: &KernelList<D>, walls: Option<&WallSet<D>>, rho0: f64) {
-        let (n, h, x) = (fluid.len(), fluid.h, &fluid.x);
+    /// Detects the surface of the body `particles` (its list `nl`, its `boundaries` as
+    /// neighbours) whose reference density is `rho0`: eq. (42) with its cut-off, eq. (43),
+    /// the low-density rule (summation density below rho0 / 2), the 60-degree test, and the
+    /// neighbours of surface particles.
+    pub fn detect(
+        &mut self,
+        particles: Particles<'_, D>,
+        nl: &KernelList<D>,
+        boundaries: Boundaries<'_, D>,
+        rho0: f64,
+    ) {
+        let Particles { x, m, rho, h } = particles;
+        let n = particles.len();
         self.n_star.resize(n, Vector::zeros());
         self.normal.resize(n, Vector::zeros());
         self.rho_sum.resize(n, 0.0);
         self.surface.resize(n, false);
         self.near.resize(n, false);
-        let wall_point = |ws: &WallSet<D>, j: usize| {
-            Point::new(Vector::<D>::zeros(), Vector::zeros(), ws.wall.m[j], ws.wall.rho(j), 0.0)
-        };
-        // Eq. (42) and the summation density, over the fluid and the walls.
+        // Eq. (42) and the summation density, over the body and its boundaries.
         self.n_star.par_iter_mut().zip(self.rho_sum.par_iter_mut()).enumerate().for_each(|(i, (ns, rs))| {
             let (mut nv, mut r) = (Vector::<D>::zeros(), 0.0);
             nl.for_each(i, x, |j, xij, r2, kw| {
-                nv += normal(&fluid_point(fluid, j), &kw.pair(xij, r2, h));
-                r += fluid.m[j] * kw.w;
+                nv += normal(&volume_point(m[j], rho[j]), &kw.pair(xij, r2, h));
+                r += m[j] * kw.w;
             });
-            if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |j, xij, r2, kw| {
-                    nv += normal(&wall_point(ws, j), &kw.pair(xij, r2, h));
-                    r += ws.wall.m[j] * kw.w;
+            for b in boundaries.iter() {
+                let (bm, brho) = (&b.model.m, &b.model.rho);
+                b.list.for_each_from(i, x[i], b.x, |j, xij, r2, kw| {
+                    nv += normal(&volume_point(bm[j], brho[j]), &kw.pair(xij, r2, h));
+                    r += bm[j] * kw.w;
                 });
             }
             *ns = cut_normal(nv, h);
@@ -67,7 +76,7 @@ impl<const D: usize> SurfaceFields<D> {
         self.normal.par_iter_mut().enumerate().for_each(|(i, out)| {
             let mut nv = Vector::<D>::zeros();
             nl.for_each(i, x, |j, xij, r2, kw| {
-                nv += smoothed_normal(&fluid_point(fluid, j), &n_star[j], &kw.pair(xij, r2, h));
+                nv += smoothed_normal(&volume_point(m[j], rho[j]), &n_star[j], &kw.pair(xij, r2, h));
             });
             let len = nv.norm();
             *out = if len > 0.0 { nv / len } else { Vector::zeros() };
@@ -87,8 +96,8 @@ impl<const D: usize> SurfaceFields<D> {
             }
             let mut covered = false;
             nl.for_each(i, x, |_, xij, r2, kw| covered |= in_normal_cone(&na, &kw.pair(xij, r2, h)));
-            if let Some(ws) = walls {
-                ws.fluid_to_wall.for_each_from(i, x[i], &ws.wall.x, |_, xij, r2, kw| {
+            for b in boundaries.iter() {
+                b.list.for_each_from(i, x[i], b.x, |_, xij, r2, kw| {
                     covered |= in_normal_cone(&na, &kw.pair(xij, r2, h))
                 });
             }
@@ -105,7 +114,7 @@ impl<const D: usize> SurfaceFields<D> {
         });
     }
 
-    /// Applies `mode` to the pressure `p` of the surface particles (the fluid's reference
+    /// Applies `mode` to the pressure `p` of the surface particles (the body's reference
     /// density `rho0` tells the isolated ones).
     pub fn apply_surface_pressure(&self, mode: SurfacePressure, rho0: f64, p: &mut [f64]) {
         let rule = |i: usize, p: f64| match mode {

@@ -1,13 +1,13 @@
 //! Work in stages over tiles, runs of a body's particles in cell order, on the threads of
 //! the pool: the wavefront step's passes ([`wavefront`](super::wavefront)) and IPST's
-//! sweeps ([`ipst`](super::ipst)). A stage of a tile needs the stage before it done on the
+//! sweeps ([`ipst`](crate::solver::passes::ipst)). A stage of a tile needs the stage before it done on the
 //! tile and on both tiles next to it (cyclically), since a particle's neighbours lie in
 //! those. Each thread owns a region of tiles and takes their stages one at a time as their
 //! inputs are done ([`Grid`]), waiting for another thread only where a stage needs one of
 //! its tiles. A stage is one task on one thread and forks nothing: a parallel loop per
 //! stage, or per sweep, ends in a join where one thread waits for the other, and on a
 //! virtual machine a waiting thread that has gone to sleep takes tens of microseconds to
-//! wake (docs/throughput.md, sessions 38-40).
+//! wake.
 //!
 //! Which thread runs a stage never changes what it computes: every sum is over the same
 //! terms in the same order.
@@ -19,24 +19,24 @@ use std::time::Instant;
 
 /// The stages done and taken on each tile, and each worker's region.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Grid {
+pub(crate) struct Grid {
     /// Stages done on each tile,
-    pub(super) done: Vec<u32>,
+    pub(crate) done: Vec<u32>,
     /// and taken by a worker (done or running).
-    pub(super) taken: Vec<u32>,
+    pub(crate) taken: Vec<u32>,
     /// The tiles of each worker's region.
-    pub(super) regions: Vec<Range<usize>>,
+    pub(crate) regions: Vec<Range<usize>>,
     /// Workers started.
-    pub(super) started: usize,
+    pub(crate) started: usize,
     /// Whether a stage unwound: the other workers then stop rather than wait for it.
-    pub(super) failed: bool,
+    pub(crate) failed: bool,
 }
 
 impl Grid {
     /// Readies the grid for the tiles `bounds` (their first particles, then the number of
     /// particles) on `workers` threads, no stage done. A tile belongs to the region its
     /// middle particle falls in, so that the regions hold about as many particles each.
-    pub(super) fn reset(&mut self, bounds: &[usize], workers: usize) {
+    pub(crate) fn reset(&mut self, bounds: &[usize], workers: usize) {
         let tiles = bounds.len() - 1;
         for v in [&mut self.done, &mut self.taken] {
             v.clear();
@@ -54,13 +54,13 @@ impl Grid {
     }
 
     /// Number of tiles.
-    pub(super) fn tiles(&self) -> usize {
+    pub(crate) fn tiles(&self) -> usize {
         self.done.len()
     }
 
     /// Whether stage `s` of tile `k` can start: it is not taken, and the stage before it
     /// is done on the tile and on both tiles next to it (cyclically).
-    pub(super) fn ready(&self, s: u32, k: usize) -> bool {
+    pub(crate) fn ready(&self, s: u32, k: usize) -> bool {
         let n = self.done.len();
         self.taken[k] == s
             && self.done[k] == s
@@ -71,7 +71,7 @@ impl Grid {
     /// The tile worker `w` takes a stage of next, and the stage, now taken: the tile `pick`
     /// chooses among its region's, else among all the tiles if the worker may take stages
     /// of other regions ([`roams`](Self::roams)); `None` if it is to wait.
-    pub(super) fn take(
+    pub(crate) fn take(
         &mut self,
         w: usize,
         stages: u32,
@@ -92,14 +92,14 @@ impl Grid {
     }
 
     /// The region tile `k` belongs to.
-    pub(super) fn region_of(&self, k: usize) -> usize {
+    pub(crate) fn region_of(&self, k: usize) -> usize {
         self.regions.iter().position(|r| r.contains(&k)).unwrap_or(0)
     }
 }
 
 /// What the workers of [`run_stages`] share, under a mutex: which stage each takes next,
 /// and what a stage done changes.
-pub(super) trait Board: Send {
+pub(crate) trait Board: Send {
     /// A stage of a tile.
     type Task: Copy + Send;
     /// What a stage returns to the board.
@@ -117,7 +117,7 @@ pub(super) trait Board: Send {
 /// Runs the stages `board` hands out on the threads of the current rayon pool, a worker a
 /// thread and as many workers as the grid has regions (on one thread, the calling thread
 /// runs them all in the order the board gives), until the board is over. Returns the board.
-pub(super) fn run_stages<B: Board>(mut board: B, run: &(impl Fn(B::Task) -> B::Out + Sync)) -> B {
+pub(crate) fn run_stages<B: Board>(mut board: B, run: &(impl Fn(B::Task) -> B::Out + Sync)) -> B {
     let workers = board.grid().regions.len();
     let board = Mutex::new(board);
     let lock = || board.lock().unwrap_or_else(PoisonError::into_inner);
@@ -178,7 +178,7 @@ impl<B: Board> Drop for FailOnUnwind<'_, B> {
 
 /// A slice that several threads write disjoint runs of at once, while other threads may
 /// read other elements.
-pub(super) struct Tiled<T> {
+pub(crate) struct Tiled<T> {
     ptr: *mut T,
     len: usize,
 }
@@ -189,7 +189,7 @@ unsafe impl<T: Send> Send for Tiled<T> {}
 unsafe impl<T: Send + Sync> Sync for Tiled<T> {}
 
 impl<T> Tiled<T> {
-    pub(super) fn new(v: &mut [T]) -> Self {
+    pub(crate) fn new(v: &mut [T]) -> Self {
         Self { ptr: v.as_mut_ptr(), len: v.len() }
     }
 
@@ -199,7 +199,7 @@ impl<T> Tiled<T> {
     /// No other thread reads or writes them while the borrow lives, and the slice is alive
     /// and not moved.
     #[allow(clippy::mut_from_ref)]
-    pub(super) unsafe fn run(&self, r: Range<usize>) -> &mut [T] {
+    pub(crate) unsafe fn run(&self, r: Range<usize>) -> &mut [T] {
         assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
         // SAFETY: in bounds (checked) and exclusive (the caller's contract).
         unsafe { std::slice::from_raw_parts_mut(self.ptr.add(r.start), r.len()) }
@@ -211,7 +211,7 @@ impl<T> Tiled<T> {
     /// # Safety
     /// No element read through the result is written while it lives, and the slice is
     /// alive and not moved.
-    pub(super) unsafe fn gather(&self) -> Gather<'_, T> {
+    pub(crate) unsafe fn gather(&self) -> Gather<'_, T> {
         // SAFETY: the whole slice, alive (the caller's contract).
         unsafe { Gather::from_raw(self.ptr, self.len) }
     }
@@ -220,7 +220,7 @@ impl<T> Tiled<T> {
     ///
     /// # Safety
     /// No thread writes them while the borrow lives, and the slice is alive and not moved.
-    pub(super) unsafe fn read(&self, r: Range<usize>) -> &[T] {
+    pub(crate) unsafe fn read(&self, r: Range<usize>) -> &[T] {
         assert!(r.start <= r.end && r.end <= self.len, "{r:?} of {}", self.len);
         // SAFETY: in bounds (checked), not written (the caller's contract).
         unsafe { std::slice::from_raw_parts(self.ptr.add(r.start), r.len()) }
@@ -229,7 +229,7 @@ impl<T> Tiled<T> {
 
 /// Rayon tasks of a stage: one, the whole tile (the workers of [`run_stages`] are the
 /// parallelism, and must not fork).
-pub(super) const WHOLE_TILE: usize = usize::MAX;
+pub(crate) const WHOLE_TILE: usize = usize::MAX;
 
 /// Drives `board` (the case `what`) as `workers` workers taking turns would, a stage a
 /// turn, the last one starting at turn 4 if `late` (a test of a [`Board`]): each turn each
@@ -238,7 +238,7 @@ pub(super) const WHOLE_TILE: usize = usize::MAX;
 /// further; `turn(board)` sees the board after each turn. Returns the turns workers found
 /// nothing to take.
 #[cfg(test)]
-pub(super) fn take_turns<B: Board>(
+pub(crate) fn take_turns<B: Board>(
     what: &str,
     b: &mut B,
     workers: usize,

@@ -1,0 +1,62 @@
+//! Who acts on whom, decided in one place: [`interaction`] is one exhaustive `match` over
+//! pairs of [`BodyKind`]s, so that a new kind of body does not compile until every pair
+//! with it is decided. Each interaction is a module of its own, holding its neighbour
+//! lists and what a particle gathers from a neighbour across it; the passes
+//! ([`passes`](crate::solver::passes)) call those per-neighbour functions inside their
+//! particle loops, chosen outside them, so the loops stay monomorphic.
+//!
+//! - [`fluid_fluid`]: a fluid's particles among themselves, CTVF eqs. (25)-(27);
+//! - [`fluid_boundary`]: a fluid reading a boundary's extrapolated values as neighbours;
+//! - [`boundary_fluid`]: a boundary extrapolating its values from a fluid (eqs. 46-52);
+//! - [`lists`]: the neighbour lists with their kernel values, shared by all of them.
+//!
+//! Reactions stay deterministic without atomics: every pass is a gather, each particle
+//! writing only its own row, in a neighbour order fixed by the lists.
+
+pub mod boundary_fluid;
+pub mod fluid_boundary;
+pub mod fluid_fluid;
+pub mod lists;
+
+use crate::solver::systems::BodyKind;
+
+/// What one body does with another's particles.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Interaction {
+    /// A fluid's particles among themselves: density, pressure and momentum (eqs. 25-27),
+    /// homogenisation and free-surface detection ([`fluid_fluid`]).
+    FluidFluid,
+    /// A fluid reads a boundary's particles as neighbours, with their extrapolated pressure
+    /// and velocities ([`fluid_boundary`]).
+    FluidBoundary,
+    /// A boundary extrapolates its pressure and velocities from a fluid (eqs. 46-52,
+    /// [`boundary_fluid`]).
+    BoundaryFluid,
+}
+
+/// How body kind `dst` is acted on by body kind `src` (`None`: not at all). For two bodies
+/// of one kind this is also the interaction of a body with itself.
+pub fn interaction(dst: BodyKind, src: BodyKind) -> Option<Interaction> {
+    use BodyKind::{Fluid, Wall};
+    match (dst, src) {
+        (Fluid, Fluid) => Some(Interaction::FluidFluid),
+        (Fluid, Wall) => Some(Interaction::FluidBoundary),
+        (Wall, Fluid) => Some(Interaction::BoundaryFluid),
+        // Walls neither move by forces nor present values to each other.
+        (Wall, Wall) => None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_fluid_and_a_wall_act_on_each_other_and_walls_on_nothing() {
+        use BodyKind::{Fluid, Wall};
+        assert_eq!(interaction(Fluid, Fluid), Some(Interaction::FluidFluid));
+        assert_eq!(interaction(Fluid, Wall), Some(Interaction::FluidBoundary));
+        assert_eq!(interaction(Wall, Fluid), Some(Interaction::BoundaryFluid));
+        assert_eq!(interaction(Wall, Wall), None);
+    }
+}
