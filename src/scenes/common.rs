@@ -378,6 +378,16 @@ pub fn shifting_fields<const D: usize>(sim: &Simulation<D>) -> Vec<Field<'static
     }
 }
 
+/// Free-surface snapshot fields of `sim`: normal, surface and near-surface flags.
+pub fn surface_fields<const D: usize>(sim: &Simulation<D>) -> Vec<Field<'static>> {
+    let Some(fs) = sim.surface() else { return Vec::new() };
+    vec![
+        Field::Vector("normal", fs.normal.iter().map(pad).collect()),
+        Field::Int("free_surface", fs.surface.iter().map(|&s| s as i64).collect()),
+        Field::Int("near_surface", fs.near.iter().map(|&s| s as i64).collect()),
+    ]
+}
+
 /// Writes a wall snapshot: prescribed velocity, extrapolated pressure and density, normal.
 pub fn write_wall<const D: usize>(path: &Path, w: &Wall<D>) -> std::io::Result<()> {
     let u: Vec<Vector<D>> = (0..w.len()).map(|i| w.velocity(i)).collect();

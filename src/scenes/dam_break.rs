@@ -18,9 +18,8 @@
 
 use super::common::{
     forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
-    time_settings, wall_params, FluidConstants,
+    surface_fields, time_settings, wall_params, FluidConstants,
 };
-use super::free_surface_demo::surface_fields;
 use super::params::{Bound, Params, Spec};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};

@@ -8,7 +8,7 @@
 
 use super::common::{
     check_size, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim,
-    scheme_params, snapshot_bodies, time_settings, wall_from, FluidConstants,
+    scheme_params, snapshot_bodies, surface_fields, time_settings, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -16,7 +16,6 @@ use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::output::vtu::Field;
 use crate::solver::scheme::{DensityModel, FluidScheme};
 use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
@@ -117,16 +116,6 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
         .build()
         .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
     Ok(Box::new(Demo { sim, outer }))
-}
-
-/// Free-surface snapshot fields of `sim`: normal, surface and near-surface flags.
-pub fn surface_fields(sim: &Simulation<2>) -> Vec<Field<'static>> {
-    let Some(fs) = sim.surface() else { return Vec::new() };
-    vec![
-        Field::Vector("normal", fs.normal.iter().map(|n| [n[0], n[1], 0.0]).collect()),
-        Field::Int("free_surface", fs.surface.iter().map(|&s| s as i64).collect()),
-        Field::Int("near_surface", fs.near.iter().map(|&s| s as i64).collect()),
-    ]
 }
 
 impl Demo {

@@ -8,13 +8,8 @@ use serde::{Deserialize, Serialize};
 ///
 /// Sec. 3.7 evaluates them after the half kick, at the step's start positions (`Start`; the
 /// authors' code does the same). We evaluate them after the drift, at the new positions
-/// (`End`), by default: every result of the project was measured so, and the paper's order
-/// is not uniformly better (measured 2026-11-23, Re = 100, t = 0.5, 32x32, L1 / max-|u|
-/// decay error: EDAC 2.43e-2 / 2.03e-2 at the start against 2.69e-2 / 1.36e-2 at the end;
-/// CTVF with SPST 6.03e-2 / 1.05e-1 against 5.76e-2 / 7.98e-2; with IPST 1.97e-2 /
-/// 2.15e-2 against 2.19e-2 / 2.20e-2; the cavity at Re = 100, 30x30, t = 5 s: Ghia
-/// deviations u 2.46e-2, v 1.98e-2 against 2.40e-2, 1.28e-2). Problem
-/// `taylor_green_rate_positions` compares the two.
+/// (`End`), by default: the paper's order is not uniformly more accurate on the
+/// Taylor-Green vortex or the cavity, as problem `taylor_green_rate_positions` shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RatePositions {

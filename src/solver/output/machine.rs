@@ -1,7 +1,7 @@
-//! The machine a run or a bench sitting ran on, part of its provenance: wall times and
-//! throughput only compare within one kind of host (docs/throughput.md keeps its figures
-//! per CPU family and model), and the same source runs its pair loops on different vector
-//! widths from host to host (`target-cpu=native`).
+//! The machine a run or a benchmark ran on, part of its provenance: wall times and
+//! throughput only compare within one kind of host (one CPU family and model), and the same
+//! source runs its pair loops on different vector widths from host to host
+//! (`target-cpu=native`).
 
 use serde::{Deserialize, Serialize};
 
@@ -119,10 +119,10 @@ fn cpu() -> (String, String, u32, u32) {
 mod tests {
     use super::*;
 
-    /// The signatures of the kinds of host in docs/throughput.md (stepping 0).
+    /// The signatures of some hosts' CPUs (stepping 0).
     #[test]
     fn family_and_model_combine_the_extended_fields() {
-        assert_eq!(family_model(0x000c_06f0), (6, 207), "Intel Xeon, the issue's kind");
+        assert_eq!(family_model(0x000c_06f0), (6, 207), "Intel Xeon (Sapphire Rapids)");
         assert_eq!(family_model(0x00a0_0f10), (25, 1), "AMD Zen 3");
         assert_eq!(family_model(0x00a1_0f10), (25, 17), "AMD Zen 4");
         assert_eq!(family_model(0x00b0_0f20), (26, 2), "AMD Zen 5");

@@ -41,34 +41,10 @@ pub struct Provenance {
     pub finished: String,
 }
 
-/// Bumped whenever the solver's results change for unchanged parameters; part of every
-/// cache key (with the crate version). 3: the neighbour lists test distances with the pair
-/// difference the passes compute, which changes the listing of pairs at exactly the
-/// support radius (W = 0 there, but the BQL mean pressure counts them). 4: a run stops as
-/// diverged at Mach 1 ([`BLOWUP_MACH`](crate::solver::simulation::BLOWUP_MACH)), not 10.
-/// 5: the Morris-form Laplacians (viscosity, EDAC pressure diffusion) take
-/// `x . grad W / (r^2 + 0.01 h^2)` from the list's kernel values (results change by rounding).
-/// 6: a particle's record carries `u~ - u` and `1 / rho`, and the EDAC transport correction
-/// is evaluated in its reduced form `V_b (p_b - p_a) du_b . grad W` (rounding again).
+/// The version of the solver's results: raised whenever they change for unchanged
+/// parameters (rounding included), so that results of an older solver read as stale. Every
+/// summary records it, and the cache keys every case by it.
 pub const SCHEME_VERSION: &str = "6";
-
-/// Versions of parts of the solver that only some cases use, each bumped whenever that
-/// part's results change for unchanged parameters: `(parameter, value, version)`. A case
-/// whose parameter has that value has the version in its cache key; every other case keeps
-/// its results. `pst = ipst`, 1: each fluid pair is evaluated once a sweep and added to
-/// both particles (results change by rounding). `pst = sun` 1 and `ipst` 2: a step shorter
-/// than the one the shifting was evaluated for (the last before an end time; adaptive steps)
-/// keeps its shifting velocity. `ipst` 3: the sweeps' slabs share the layers out evenly,
-/// eight layers at least, in a power-of-two number (the sums change by rounding).
-/// `surface_pressure` other than `evolve`, 1: the walls' pressure is extrapolated from the
-/// surface pressures as set, not as evolved.
-pub const PART_VERSIONS: &[(&str, &str, u32)] = &[
-    ("pst", "sun", 1),
-    ("pst", "ipst", 3),
-    ("surface_pressure", "zero", 1),
-    ("surface_pressure", "zero_isolated", 1),
-    ("surface_pressure", "non_negative", 1),
-];
 
 impl Provenance {
     /// Provenance of this binary, for a run that started at `started`.

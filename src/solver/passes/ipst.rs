@@ -262,8 +262,8 @@ impl<'a, const D: usize> BoundaryVolumes<'a, D> {
 /// The particle whose chi a sweep's test (eq. 39) takes first: once the flow has developed,
 /// a particle whose chi is above the bound stays above it from move to move, and its chi
 /// alone fails the test (the largest chi of all is then above it too). The sweeps then
-/// need not sum chi for every particle: without it IPST took 10-19 % less time on the
-/// Intel model 207 host (docs/throughput.md, session 51). The test's outcome is the same
+/// need not sum chi for every particle: without it IPST took 10-19 % less time. The test's
+/// outcome is the same
 /// as on every chi; which slabs find the witness's chi first, and so sum their own, may
 /// depend on the threads' timing, and changes nothing but the time.
 #[derive(Debug, Default)]
@@ -438,8 +438,7 @@ const IPST_SLAB: usize = if cfg!(miri) { 64 } else { 1024 };
 /// Fewest cell layers in an IPST slab: the pairs between a slab's last layer and the next
 /// slab's first are set aside and added in a second loop, at about twice the cost of a pair
 /// within the slab, so thin slabs cost more. Eight rather than four took 4-7 % off a sweep
-/// on one thread and about 10 % on two at nx = 100 (session 28, samples in the sweeps
-/// against the rest of the step), and still gives two slabs at nx = 50.
+/// on one thread and about 10 % on two at nx = 100, and still gives two slabs at nx = 50.
 const IPST_SLAB_LAYERS: usize = if cfg!(miri) { 2 } else { 8 };
 /// Particles whose pairs an IPST sweep evaluates together: their arrays stay in the first
 /// cache level, and the vectorised loops run over the group's pairs, padded once. Sixteen
@@ -455,12 +454,9 @@ struct IpstSlab<const D: usize> {
     /// The slab's fluid pairs `j > i`, listed once a step. The sweeps read the neighbours'
     /// volumes `V_j` from the particles' compact array, not from a copy per pair: the copy
     /// (112 bytes a particle) doubled IPST's memory, and where the step's lists and IPST's
-    /// arrays no longer fit the cache together (nx = 180-300 on the host of session 37), the
-    /// passes around the sweeps took 1.4-1.8x their time without IPST, and 1.0-1.5x without
-    /// the copy, from spell to spell (docs/throughput.md, session 37). Part of that is time,
-    /// not memory: in session 40 a pause as long as the sweeps, touching no memory, slowed
-    /// the passes after it as much as the sweeps did (probably the host's other tenants
-    /// evicting what a step left in the shared cache).
+    /// arrays no longer fit the cache together (nx = 180-300 on one host), the passes
+    /// around the sweeps took 1.4-1.8x their time without IPST, and 1.0-1.5x without the
+    /// copy.
     half: HalfPairs,
     pairs: IpstPairs<D>,
     spill: Vec<(u32, Vector<D>)>,
@@ -468,12 +464,11 @@ struct IpstSlab<const D: usize> {
 
 impl<const D: usize> IpstSlab<D> {
     /// The slab's share of one sweep: for its particles `particles` (whose sums `sums`
-    /// it zeroes first), each fluid pair `j > i` once, added to both particles (to `j`'s
-    /// spill if `j` is outside the slab), and each wall pair.
+    /// it zeroes first), each pair `j > i` of the body once, added to both particles (to
+    /// `j`'s spill if `j` is outside the slab), and each boundary pair.
     ///
     /// Never inlined: built with `codegen-units = 1` or fat LTO, the compiler inlined it
-    /// into the stage closure of [`FluidPasses::ipst`], and a `ctvf`+`ipst` step ran 8-9 %
-    /// slower (docs/throughput.md, session 43).
+    /// into the stage closure of [`Ipst::run`], and a `ctvf`+`ipst` step ran 8-9 % slower.
     #[allow(clippy::too_many_arguments)]
     #[inline(never)]
     fn sweep(

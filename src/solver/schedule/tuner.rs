@@ -16,7 +16,7 @@ pub enum Schedule {
 
 /// Steps a [`Tuner`] runs a schedule for in a row (`BLOCK`), and how many of the first of
 /// them it does not time (`SETTLE`): a schedule pays for its predecessor's state for two
-/// or three steps after a change. On the host of session 38, at nx = 200 on two threads,
+/// or three steps after a change. At nx = 200 on two threads, on one host,
 /// `edac`'s first steps in tiles after sweeps ran 10-20 % faster than the ones after them,
 /// and the sweeps' first steps after tiles 10-20 % slower: timed step by step in
 /// alternation, the tiles looked faster than the sweeps, and ran 13 % slower when kept.
@@ -32,7 +32,7 @@ const ROUNDS: usize = 3;
 /// and passes took 4-6 % longer in tiles and 6-17 % in sweeps (nx = 200, one thread), and where
 /// `edac` at nx = 200 on two threads ran within 3 % in either order alone, the sweeps ran
 /// 338 ns a particle-step against 297 for the tiles when stepped side by side with other
-/// runs (`bench --interleave`; session 40).
+/// runs (`bench --interleave`).
 const SWEEPS_MARGIN: f64 = 0.03;
 
 /// Steps the tuner takes at most before it keeps a schedule: a block of sweeps untimed (a
@@ -41,8 +41,7 @@ const SWEEPS_MARGIN: f64 = 0.03;
 pub const TUNING_STEPS: usize = (1 + 2 * ROUNDS) * BLOCK;
 
 /// Picks the faster of the sweeps and the wavefront for a body. Which one
-/// is faster is a property of the host and the scheme: on the host of session 35 the
-/// wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
+/// is faster is a property of the host and the scheme: on one host the wavefront was 1.45x faster at nx = 400 but 10 % slower on two threads at nx = 256, where
 /// the list still fitted its cache; on hosts whose memory kept up with the sweeps, only
 /// its cost would show. The first steps go round the candidates in blocks of `BLOCK`
 /// steps, `ROUNDS` times, then the one with the shortest median timed step (of the last

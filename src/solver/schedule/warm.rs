@@ -10,7 +10,7 @@
 //! avoid this by letting their threads spin between parallel regions; [`keep_warm`] does
 //! the same for the pool that steps a simulation. Measured on a 2-vCPU KVM host (Zen 4):
 //! two threads ran 6-12 % more particle-steps a second at 10 000 particles, the same
-//! within the noise at 40 000 and more (docs/throughput.md, session 27).
+//! within the noise at 40 000 and more.
 //!
 //! It changes which thread runs which task, never a result: the passes fix every order of
 //! addition themselves.

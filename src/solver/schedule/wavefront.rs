@@ -52,8 +52,8 @@ use std::collections::VecDeque;
 use std::ops::Range;
 use std::time::Instant;
 
-/// The fewest tiles a wavefront step is run with (from nx = 130 or so in 2D). On the host
-/// of session 39, `ctvf`+`ipst` at nx = 150 (ten tiles) ran 6-8 % faster in tiles than in
+/// The fewest tiles a wavefront step is run with (from nx = 130 or so in 2D). On one host,
+/// `ctvf`+`ipst` at nx = 150 (ten tiles) ran 6-8 % faster in tiles than in
 /// sweeps on one thread; at nx = 100 (six tiles), whose list the cache mostly holds, the
 /// two took the same time in three rounds, so offering the tiles there only gave the tuner
 /// a choice to get wrong.

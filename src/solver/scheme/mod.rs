@@ -62,14 +62,13 @@ named_choices!(Pst {
 /// error of the SPH gradient of a disordered particle set to the momentum equation (P > 0
 /// pushes particles into voids, P < 0 pulls them together). Subtracting the mean pressure
 /// of the neighbours (Basa, Quinlan & Lastiwka 2009, BQL) leaves the force to pressure
-/// differences. Measured (2026-11-22, 50x50, problems `taylor_green_pressure_reference` and
-/// `cavity_pressure_reference`): in the Taylor-Green vortex EDAC's pressure level rises to
-/// 3 rho U^2 within 0.2 s, and under eq. (27) the time-averaged L1 error is 3-9x that with
-/// BQL; in the lid-driven cavity the level stays near 0.5 rho U^2 under eq. (27), which
-/// keeps the fluid under the lid free of voids, while with BQL voids open there and at
-/// Re = 1000 the fluid leaves the cavity (t = 3.2 s). The fluid's mean as reference (session
-/// 7) comes close to BQL in the Taylor-Green vortex (mean L1 6.5 % against 4.0 % and 35 %,
-/// SPST, Re = 100) but loses the cavity too (t = 7.7 s at Re = 1000, 21.5 s at Re = 100).
+/// differences. In the Taylor-Green vortex EDAC's pressure level rises to a few rho U^2,
+/// and under eq. (27) the error grows several times that with BQL; in the lid-driven cavity
+/// the level stays near 0.5 rho U^2 under eq. (27), which keeps the fluid under the lid
+/// free of voids, while with BQL voids open there and at Re = 1000 the fluid leaves the
+/// cavity. The fluid's mean as reference comes close to BQL in the Taylor-Green vortex but
+/// loses the cavity too. Problems `taylor_green_pressure_reference` and
+/// `cavity_pressure_reference` compare them.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum PressureReference {
@@ -106,12 +105,10 @@ named_choices!(PressureReference {
 
 /// What the pressure of the free-surface particles (sec. 3.4) does. The paper's text
 /// evolves every particle's pressure by eq. (26); the authors' public PySPH code can also
-/// zero p and dp/dt of the surface particles. In the dam break at dx = 0.02 (measured
-/// 2026-11-22, to t = 2.5 s) none is robust: with `Evolve` an isolated droplet can hold a
-/// tension of -4e6 Pa and blow up (IPST at t = 2.38 s); with `Zero` a surface particle
-/// meets a wall without pressure and goes through it (IPST, t = 1.35 s); `ZeroIsolated`
-/// completes IPST and SPST with corrections but throws a drop 4 m out of the tank without
-/// them; `NonNegative` throws drops out in all three.
+/// zero p and dp/dt of the surface particles. In the dam break none is robust on its own:
+/// with `Evolve` an isolated droplet can hold a large tension and blow up; with `Zero` a
+/// surface particle can meet a wall without pressure and go through it; `ZeroIsolated` and
+/// `NonNegative` can throw drops out of the tank (problem `dam_break_stability` maps them).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum SurfacePressure {
