@@ -4,7 +4,7 @@
 use super::expand::Expand;
 use super::model::{valid_name, Problem, DEFAULT_PRESET};
 use super::schema::{Loc, ProblemFile};
-use crate::scenes::{self, SceneEntry};
+use crate::scenes;
 use std::path::{Path, PathBuf};
 
 /// Loads and validates every `*.toml` in `dir`, sorted by name, expanded for `preset`.
@@ -44,17 +44,6 @@ pub fn load(path: &Path, preset: &str) -> Result<Problem, String> {
 
 /// [`load`] from a string (`path` names it in errors and locates `reference_data/`).
 pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
-    parse_with(path, src, preset, scenes::find)
-}
-
-/// [`parse`] with the scenes looked up by `find` (tests validate problem files against
-/// declared scene contracts with it).
-pub fn parse_with(
-    path: &Path,
-    src: &str,
-    preset: &str,
-    find: fn(&str) -> Result<&'static SceneEntry, String>,
-) -> Result<Problem, String> {
     let loc = Loc { path, src };
     let file: ProblemFile = toml::from_str(src).map_err(|e| {
         let line = e.span().map(|s| loc.line(s.start)).unwrap_or(1);
@@ -63,7 +52,7 @@ pub fn parse_with(
         let quoted = if text.is_empty() || text.len() > 80 { String::new() } else { format!("`{text}`: ") };
         format!("{}:{line}: {quoted}{}", path.display(), e.message().trim_end().replace('\n', " "))
     })?;
-    let scene = find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
+    let scene = scenes::find(file.scene.get_ref()).map_err(|e| loc.err(file.scene.span(), "scene", e))?;
     let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
     if !valid_name(&name) {
         return Err(format!(

@@ -18,7 +18,7 @@ mod model;
 mod reference;
 mod schema;
 
-pub use load::{load, load_dir, parse, parse_with};
+pub use load::{load, load_dir, parse};
 pub use model::{
     glob_matches, Bound, Case, Figure, FigureKind, Problem, Reference, Select, Table, DEFAULT_PRESET,
 };
