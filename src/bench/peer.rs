@@ -84,7 +84,7 @@ pub(super) fn peer_run(script: &Path, nx: usize, threads: usize, tf: f64) -> Res
         .output()
         .map_err(|e| e.to_string())?;
     if !o.status.success() {
-        return Err(format!("exit status {}", o.status));
+        return Err(o.status.to_string());
     }
     parse_peer(&String::from_utf8_lossy(&o.stdout), nx, threads, tf)
 }
