@@ -5,7 +5,6 @@ use sphrepro::automation::commands::{self, Dirs, RunFlags};
 use sphrepro::automation::runner;
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
-use sphrepro::solver::simulation::TUNING_STEPS;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -126,12 +125,11 @@ struct BenchArgs {
     /// Where to write the results as JSON.
     #[arg(long, default_value = "output/bench.json")]
     json: PathBuf,
-    /// A peer code's runner to measure in the same sitting, e.g.
+    /// A peer code's runner to measure in the same rounds as ours, e.g.
     /// `../shared/peers/pysph-taylor-green.sh`: called with `--nx N --tf T --threads K`
     /// for every resolution and thread count, it must print one JSON line with
     /// `particle_steps_per_second`; the table then gives our ratio to it at each size
-    /// and, when nx = 50 is among the resolutions, to its nx = 50 run (the issue's
-    /// figure to beat).
+    /// and, when nx = 50 is among the resolutions, to its nx = 50 run.
     #[arg(long)]
     peer: Option<PathBuf>,
     /// The kernel of every case (with h/dx = 1); the default is the paper's and PySPH's.
@@ -144,6 +142,13 @@ struct BenchArgs {
     /// the resident growth while each simulation was built.
     #[arg(long, value_name = "ROUNDS", conflicts_with_all = ["repeat", "peer"], value_parser = clap::value_parser!(u32).range(2..))]
     interleave: Option<u32>,
+}
+
+impl BenchArgs {
+    fn options(self) -> bench::Options {
+        let BenchArgs { nx, bench_threads, variants, steps, repeat, json, peer, kernel, interleave } = self;
+        bench::Options { nx, threads: bench_threads, variants, steps, repeat, json, peer, kernel, interleave }
+    }
 }
 
 #[derive(Subcommand)]
@@ -346,13 +351,13 @@ fn run(cli: Cli) -> ExitCode {
             &out,
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
-        Command::Bench(args) => run_bench(args),
+        Command::Bench(args) => ExitCode::from(bench::run(&args.options())),
         Command::BenchCase { variant, nx, steps, kernel } => {
-            print_json(bench::run_case(&variant, nx, steps, BENCH_WARMUP, &kernel))
+            ExitCode::from(bench::case_child(&variant, nx, steps, &kernel))
         }
-        Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => print_json(
-            bench::run_interleaved(&variants, nx, &bench_threads, steps, rounds, BENCH_WARMUP, &kernel),
-        ),
+        Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => {
+            ExitCode::from(bench::interleaved_child(&variants, nx, &bench_threads, steps, rounds, &kernel))
+        }
     }
 }
 
@@ -419,319 +424,5 @@ fn print_scenes() {
             println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
         }
         println!("    metrics: {}", s.metrics.join(", "));
-    }
-}
-
-/// sphrepro `edac`'s L1 velocity error on a peer's run (Taylor-Green, `nx`, Re = 100, to
-/// `tf`, on `threads` threads, with `kernel`), through `simulate` into a temporary folder.
-fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &str) -> Result<f64, String> {
-    let dir = std::env::temp_dir().join(format!("sphrepro-bench-l1-{}-{nx}-{threads}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let set = |kv: String| ["--set".to_string(), kv];
-    let mut args =
-        vec!["--threads".to_string(), threads.to_string(), "simulate".into(), "taylor_green".into()];
-    for kv in [
-        format!("nx={nx}"),
-        "re=100".into(),
-        "scheme=edac".into(),
-        format!("kernel={kernel}"),
-        format!("tf={tf}"),
-        format!("output_dt={tf}"),
-    ] {
-        args.extend(set(kv));
-    }
-    args.extend(["--quiet".into(), "--out".into(), dir.display().to_string()]);
-    let out = std::process::Command::new(exe).args(&args).output().map_err(|e| e.to_string())?;
-    let summary = std::fs::read(dir.join("summary.json"));
-    let _ = std::fs::remove_dir_all(&dir);
-    if !out.status.success() {
-        return Err(String::from_utf8_lossy(&out.stderr).trim().to_string());
-    }
-    let v: serde_json::Value = serde_json::from_slice(&summary.map_err(|e| e.to_string())?)
-        .map_err(|e| format!("summary.json: {e}"))?;
-    v["metrics"]["l1_velocity_final"]
-        .as_f64()
-        .ok_or_else(|| "summary.json: no `l1_velocity_final`".to_string())
-}
-
-/// Untimed steps before a bench case is timed: enough for a tuned step schedule to have
-/// timed its choices and kept one.
-const BENCH_WARMUP: u64 = TUNING_STEPS as u64 + 2;
-
-/// A bench child's result as one JSON line on stdout, or its error on stderr (exit 1).
-fn print_json(r: Result<impl serde::Serialize, String>) -> ExitCode {
-    match r {
-        Ok(r) => {
-            println!("{}", serde_json::to_string(&r).expect("serialises"));
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(1)
-        }
-    }
-}
-
-/// Runs the hidden bench subcommand `args` in a child process and reads its JSON result.
-fn bench_child<T: serde::de::DeserializeOwned>(exe: &std::path::Path, args: &[&str]) -> Result<T, String> {
-    let o = std::process::Command::new(exe)
-        .args(args)
-        .output()
-        .map_err(|e| format!("cannot run {}: {e}", exe.display()))?;
-    if !o.status.success() {
-        return Err(format!("failed: {}", String::from_utf8_lossy(&o.stderr)));
-    }
-    serde_json::from_slice(&o.stdout).map_err(|e| format!("unreadable result: {e}"))
-}
-
-/// One benchmark configuration, timed in a process of its own (`bench-case`) so that each
-/// starts from the same memory state and its peak memory is its own.
-fn bench_case(
-    exe: &std::path::Path,
-    variant: &str,
-    nx: usize,
-    threads: usize,
-    steps: u64,
-    kernel: &str,
-) -> Result<bench::BenchResult, String> {
-    let (nx, threads, steps) = (nx.to_string(), threads.to_string(), steps.to_string());
-    bench_child(
-        exe,
-        &[
-            "--threads",
-            &threads,
-            "bench-case",
-            "--variant",
-            variant,
-            "--nx",
-            &nx,
-            "--steps",
-            &steps,
-            "--kernel",
-            kernel,
-        ],
-    )
-}
-
-/// The cases of resolution `nx` timed side by side in a process of their own
-/// (`bench-interleaved`; see `bench::run_interleaved`).
-fn bench_interleaved(
-    exe: &std::path::Path,
-    variants: &[String],
-    nx: usize,
-    threads: &[usize],
-    steps: u64,
-    rounds: u32,
-    kernel: &str,
-) -> Result<Vec<bench::BenchResult>, String> {
-    let variants = variants.join(",");
-    let threads = threads.iter().map(|t| t.to_string()).collect::<Vec<_>>().join(",");
-    let (nx, steps, rounds) = (nx.to_string(), steps.to_string(), rounds.to_string());
-    bench_child(
-        exe,
-        &[
-            "bench-interleaved",
-            "--variants",
-            &variants,
-            "--nx",
-            &nx,
-            "--bench-threads",
-            &threads,
-            "--steps",
-            &steps,
-            "--rounds",
-            &rounds,
-            "--kernel",
-            kernel,
-        ],
-    )
-}
-
-/// One run of a peer's script at `nx` on `threads` threads to time `tf`, read from the
-/// JSON line it prints.
-fn peer_run(
-    script: &std::path::Path,
-    nx: usize,
-    threads: usize,
-    tf: f64,
-) -> Result<bench::PeerResult, String> {
-    let o = std::process::Command::new(script)
-        .args(["--nx", &nx.to_string(), "--tf", &format!("{tf}"), "--threads", &threads.to_string()])
-        .stderr(std::process::Stdio::inherit())
-        .output()
-        .map_err(|e| e.to_string())?;
-    if !o.status.success() {
-        return Err(format!("exit status {}", o.status));
-    }
-    bench::parse_peer(&String::from_utf8_lossy(&o.stdout), nx, threads, tf)
-}
-
-fn run_bench(args: BenchArgs) -> ExitCode {
-    let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel, interleave } =
-        args;
-    let started = chrono::Utc::now();
-    let kernel = kernel.as_str();
-    if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
-        eprintln!(
-            "error: bench: --kernel {kernel}: expected one of {}",
-            sphrepro::solver::kernel::KernelKind::NAMES.join(", ")
-        );
-        return ExitCode::from(2);
-    }
-    let variants: Vec<String> =
-        variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
-    // Every argument is checked before the first case runs, so that a typo costs no sitting.
-    if let Some(v) = variants.iter().find(|v| !bench::known_variant(v)) {
-        let known: Vec<&str> = bench::VARIANTS.iter().map(|k| k.0).collect();
-        let suffixes: Vec<&str> = bench::SCHEDULES.iter().map(|s| s.0).collect();
-        eprintln!(
-            "error: bench: --variants {v}: expected one of {}, each optionally ending in {}",
-            known.join(", "),
-            suffixes.join(" or ")
-        );
-        return ExitCode::from(2);
-    }
-    if let Some(script) = peer.as_ref().filter(|p| !p.is_file()) {
-        eprintln!("error: bench: --peer {}: no such file", script.display());
-        return ExitCode::from(2);
-    }
-    let exe = std::env::current_exe().expect("own executable");
-    let (mut results, mut peers) = (Vec::new(), Vec::new());
-    // A case or a peer run that fails ends the sitting, but what was measured before it is
-    // still reported and written.
-    let mut failure: Option<String> = None;
-    if let Some(rounds) = interleave {
-        for &n in &nx {
-            let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-            eprint!(
-                "bench nx={n}, {} on {threads:?} threads side by side, {rounds} rounds of {} steps each ... ",
-                variants.join(", "),
-                k.div_ceil(rounds as u64)
-            );
-            match bench_interleaved(&exe, &variants, n, &threads, k, rounds, kernel) {
-                Ok(r) => {
-                    let speeds: Vec<String> = r
-                        .iter()
-                        .map(|r| {
-                            format!(
-                                "{} on {}: {:.3} M",
-                                r.variant,
-                                r.threads_label(),
-                                r.particle_steps_per_second / 1e6
-                            )
-                        })
-                        .collect();
-                    eprintln!("{}", speeds.join(", "));
-                    results.extend(r);
-                }
-                Err(e) => {
-                    eprintln!("{e}");
-                    failure = Some(format!("bench nx={n}, side by side: {e}"));
-                    break;
-                }
-            }
-        }
-    }
-    // Side by side, our cases ran above: no rounds of processes.
-    let repeat = if interleave.is_some() { 0 } else { repeat };
-    'rounds: for round in 1..=repeat {
-        let of = if repeat > 1 { format!(" (run {round} of {repeat})") } else { String::new() };
-        for &n in &nx {
-            for v in &variants {
-                for &t in &threads {
-                    let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-                    eprint!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
-                    match bench_case(&exe, v, n, t, k, kernel) {
-                        Ok(r) => {
-                            eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
-                            results.push(r);
-                        }
-                        Err(e) => {
-                            eprintln!("{e}");
-                            failure = Some(format!("bench {v} nx={n} threads={t}: {e}"));
-                            break 'rounds;
-                        }
-                    }
-                }
-            }
-        }
-        // The peer in the same round, so that a slow spell falls on both codes alike.
-        if let Some(script) = &peer {
-            for &n in &nx {
-                for &t in &threads {
-                    let tf = bench::peer_tf(n);
-                    eprint!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
-                    match peer_run(script, n, t, tf) {
-                        Ok(p) => {
-                            eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
-                            peers.push(p);
-                        }
-                        Err(e) => {
-                            eprintln!("error: peer {}: {e}", script.display());
-                            failure = Some(format!("peer {} nx={n} threads={t}: {e}", script.display()));
-                            break 'rounds;
-                        }
-                    }
-                }
-            }
-        }
-    }
-    // Side by side, each configuration is one result already, its blocks its runs.
-    let results = if interleave.is_some() { results } else { bench::median_runs(results) };
-    let mut peers = bench::median_runs(peers);
-    for p in &mut peers {
-        let (n, t) = (p.nx, p.threads);
-        eprint!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
-        match edac_l1(&exe, n, t, p.end_time(), kernel) {
-            Ok(l1) => {
-                p.sphrepro_l1_velocity_final = Some(l1);
-                let peer = p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
-                eprintln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
-            }
-            Err(e) => {
-                eprintln!("\nerror: edac on the peer's run: {e}");
-                failure.get_or_insert(format!("edac on the peer's run nx={n} threads={t}: {e}"));
-            }
-        }
-    }
-    // The host and build: figures compare only within one kind of host, and without a
-    // vector path for the distance test the neighbour list costs a host more.
-    let provenance = sphrepro::solver::output::summary::Provenance::now(started);
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", provenance.machine.describe());
-    println!("{}", bench::table(&results, &peers));
-    let targets = bench::targets::targets(&results, &peers);
-    if !targets.is_empty() {
-        // The issue's figures are PySPH's own run, with its quintic spline.
-        let caveat = if kernel == bench::DEFAULT_KERNEL {
-            String::new()
-        } else {
-            format!(" (they are set for the {} kernel; this sitting ran {kernel})", bench::DEFAULT_KERNEL)
-        };
-        println!(
-            "Against the targets of issue 3, in this sitting{caveat}:\n\n{}",
-            bench::targets::table(&targets)
-        );
-    }
-    if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
-        if let Err(e) = std::fs::create_dir_all(dir) {
-            eprintln!("error: {}: {e}", dir.display());
-            return ExitCode::from(1);
-        }
-    }
-    let text = serde_json::to_string_pretty(
-        &serde_json::json!({ "provenance": provenance, "results": results, "peers": peers, "targets": targets }),
-    )
-    .expect("serialises");
-    if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {
-        eprintln!("error: {}: {e}", json.display());
-        return ExitCode::from(1);
-    }
-    eprintln!("wrote {}", json.display());
-    match failure {
-        Some(e) => {
-            eprintln!("error: the sitting stopped early (the table and the JSON hold what ran before): {e}");
-            ExitCode::from(1)
-        }
-        None => ExitCode::SUCCESS,
     }
 }

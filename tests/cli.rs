@@ -233,10 +233,10 @@ fn a_completed_run_writes_the_contracted_outputs() {
     assert!(dir.path().join("vtu/fluid_00010.vtu").exists());
 }
 
-/// `bench --peer` runs the peer in the same sitting for every size and thread count and
-/// gives our ratio to it; a failing peer fails the bench, naming the script.
+/// `bench --peer` runs the peer in the same rounds as ours for every size and thread count
+/// and gives our ratio to it; a failing peer fails the bench, naming the script.
 #[test]
-fn bench_measures_a_peer_in_the_same_sitting() {
+fn bench_measures_a_peer_alongside() {
     use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
     let script = |name: &str, body: &str| {
@@ -263,7 +263,7 @@ fn bench_measures_a_peer_in_the_same_sitting() {
     let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     let (ours, peer) = (&v["results"][0], &v["peers"][0]);
     assert_eq!(peer["nx"], 20);
-    assert_eq!(peer["tf"], 2.0, "small sizes run the issue's t = 2");
+    assert_eq!(peer["tf"], 2.0, "small sizes run to t = 2");
     let ratio = ours["particle_steps_per_second"].as_f64().unwrap() / 125000.0;
     assert!(table.contains(&format!("| 0.125 | {ratio:.1}x |")), "{table}");
     // A peer that fails.
@@ -397,7 +397,7 @@ fn bench_interleaves_the_cases_of_a_size() {
     // Two copies did twice the steps of one in the same rounds.
     let steps = |i: usize| v["results"][i]["steps"].as_u64().unwrap();
     assert_eq!(steps(2), 2 * steps(0));
-    // One shape with or without a peer: the provenance of the sitting (the build, and the
+    // One shape with or without a peer: the provenance of the run (the build, and the
     // machine, named in the title too).
     let (build, host) = (&v["provenance"], &v["provenance"]["machine"]);
     assert_eq!(build["version"], env!("CARGO_PKG_VERSION"));

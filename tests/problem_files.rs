@@ -1,145 +1,8 @@
 //! Every problem file in `problems/` validates (every preset, figures, tables, bounds and
 //! the reference data they draw against), against the registered scenes.
-//!
-//! Scenes not yet registered but whose contract is fixed (issue 5: `cavity`,
-//! `hydrostatic_tank`, `dam_break` and `free_surface_demo`) are validated against stubs
-//! declaring that contract's parameters and metrics; once a scene is registered the stub is no longer used, so the real
-//! declaration is what the file is checked against. A problem naming any other unknown
-//! scene fails.
 
 use sphrepro::automation::registry;
-use sphrepro::scenes::params::{Bound, Params, Spec};
-use sphrepro::scenes::{self, common_params, SceneEntry, SceneRun};
 use std::path::Path;
-
-fn unbuildable(_: &Params) -> Result<Box<dyn SceneRun>, String> {
-    Err("stub scene: the contract of a scene not registered yet".into())
-}
-
-const SWITCH: &[&str] = &["auto", "on", "off"];
-
-fn fluid_params() -> Vec<Spec> {
-    vec![
-        Spec::choice("scheme", &["edac", "tvf", "ctvf"], "ctvf", "fluid scheme"),
-        Spec::choice("pst", &["sun", "ipst", "none"], "sun", "particle shifting"),
-        Spec::choice("corrections", &["all", "none"], "all", "the CTVF correction terms"),
-    ]
-}
-
-fn cavity_params() -> Vec<Spec> {
-    let mut v = vec![
-        Spec::int("nx", 50, 1, "particles per side"),
-        Spec::float("re", 100.0, Bound::Positive, "Reynolds number"),
-    ];
-    v.extend(fluid_params());
-    v.extend([
-        Spec::choice("corr_continuity", SWITCH, "auto", ""),
-        Spec::choice("corr_pressure", SWITCH, "auto", ""),
-        Spec::choice("corr_momentum", SWITCH, "auto", ""),
-        Spec::choice(
-            "kernel",
-            &["cubic_spline", "quintic_spline", "wendland_c2", "gaussian"],
-            "quintic_spline",
-            "",
-        ),
-        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
-        Spec::float("ke_window", 1.0, Bound::Positive, "steady-state window (s)"),
-    ]);
-    v.extend(common_params(10.0));
-    v
-}
-
-fn tank_params() -> Vec<Spec> {
-    let mut v = vec![
-        Spec::float("dx", 0.02, Bound::Positive, "particle spacing (m)"),
-        Spec::float("height", 1.0, Bound::Positive, "fluid column height (m)"),
-        Spec::float("width", 1.0, Bound::Positive, "tank width (m)"),
-    ];
-    v.extend(fluid_params());
-    v.extend(common_params(2.0));
-    v
-}
-
-/// The dam break's contract (issue 5, CTVF sec. 4.3): the fluid scheme parameters, the
-/// geometry, artificial viscosity, and snapshots every 0.1 s by default.
-fn dam_break_params() -> Vec<Spec> {
-    let mut v = vec![
-        Spec::float("dx", 0.02, Bound::Positive, "particle spacing (m)"),
-        Spec::float("column_width", 1.0, Bound::Positive, "L (m)"),
-        Spec::float("column_height", 2.0, Bound::Positive, "(m)"),
-        Spec::float("tank_width", 4.0, Bound::Positive, "(m)"),
-        Spec::float("tank_height", 3.0, Bound::Positive, "(m)"),
-        Spec::float("alpha", 0.05, Bound::NonNegative, "artificial viscosity"),
-    ];
-    v.extend(scenes::common::scheme_params("sun"));
-    v.extend(common_params(2.5).into_iter().map(|s| match s.name {
-        "output_dt" => Spec::float("output_dt", 0.1, Bound::NonNegative, "snapshot interval (s)"),
-        _ => s,
-    }));
-    v
-}
-
-/// The free-surface detection test's contract (issue 5, CTVF sec. 3.4).
-fn free_surface_params() -> Vec<Spec> {
-    let mut v = vec![
-        Spec::choice("shape", &["ring", "patch", "column"], "ring", "fluid shape"),
-        Spec::float("dx", 0.05, Bound::Positive, "particle spacing (m)"),
-    ];
-    v.extend(common_params(1e-4));
-    v
-}
-
-/// The contract of issue 5 ("Walls and free surfaces").
-static STUBS: &[SceneEntry] = &[
-    SceneEntry {
-        name: "cavity",
-        dim: 2,
-        about: "stub: lid-driven cavity (issue 5 contract)",
-        params: cavity_params,
-        build: unbuildable,
-        check: |_| Ok(()),
-        metrics: &["ghia_u_rms", "ghia_u_max", "ghia_v_rms", "ghia_v_max", "kinetic_energy_change"],
-        columns: sphrepro::scenes::cavity::ENTRY.columns,
-        outputs: 0,
-    },
-    SceneEntry {
-        name: "hydrostatic_tank",
-        dim: 2,
-        about: "stub: hydrostatic tank (issue 5 contract)",
-        params: tank_params,
-        build: unbuildable,
-        check: |_| Ok(()),
-        metrics: &["pressure_rel_error", "max_speed"],
-        columns: sphrepro::scenes::hydrostatic_tank::ENTRY.columns,
-        outputs: 0,
-    },
-    SceneEntry {
-        name: "dam_break",
-        dim: 2,
-        about: "stub: dam break (issue 5 contract)",
-        params: dam_break_params,
-        build: unbuildable,
-        check: |_| Ok(()),
-        metrics: &["toe_rms", "particles_lost", "max_penetration"],
-        columns: sphrepro::scenes::dam_break::ENTRY.columns,
-        outputs: 0,
-    },
-    SceneEntry {
-        name: "free_surface_demo",
-        dim: 2,
-        about: "stub: free-surface detection (issue 5 contract)",
-        params: free_surface_params,
-        build: unbuildable,
-        check: |_| Ok(()),
-        metrics: &["surface_particles", "interior_surface_particles"],
-        columns: sphrepro::scenes::free_surface_demo::ENTRY.columns,
-        outputs: 0,
-    },
-];
-
-fn find(name: &str) -> Result<&'static SceneEntry, String> {
-    scenes::find(name).or_else(|e| STUBS.iter().find(|s| s.name == name).ok_or(e))
-}
 
 #[test]
 fn every_problem_file_validates() {
@@ -154,8 +17,8 @@ fn every_problem_file_validates() {
     let mut errors = Vec::new();
     for p in &paths {
         let src = std::fs::read_to_string(p).unwrap();
-        // `parse_with` expands and checks every preset whichever is asked for.
-        match registry::parse_with(p, &src, "quick", find) {
+        // `parse` expands and checks every preset whichever is asked for.
+        match registry::parse(p, &src, "quick") {
             Ok(pr) => assert!(!pr.cases.is_empty()),
             Err(e) => errors.push(e),
         }
@@ -163,13 +26,14 @@ fn every_problem_file_validates() {
     assert!(errors.is_empty(), "{}", errors.join("\n"));
 }
 
-/// The cavity problem: the presets the brief asks for, and Ghia's points for both Re.
+/// The cavity problem: the resolutions and end time of each preset, and Ghia's points for
+/// both Re.
 #[test]
 fn cavity_presets_and_reference_points() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("problems/cavity.toml");
     let src = std::fs::read_to_string(&path).unwrap();
-    let quick = registry::parse_with(&path, &src, "quick", find).unwrap();
-    let paper = registry::parse_with(&path, &src, "paper", find).unwrap();
+    let quick = registry::parse(&path, &src, "quick").unwrap();
+    let paper = registry::parse(&path, &src, "paper").unwrap();
     let res = |p: &registry::Problem, re: f64| {
         let mut v: Vec<i64> = p
             .cases
@@ -217,7 +81,7 @@ fn every_problem_plots_without_results() {
     {
         let path = dir.join(format!("{name}.toml"));
         let src = std::fs::read_to_string(&path).unwrap();
-        let p = registry::parse_with(&path, &src, "quick", find).unwrap();
+        let p = registry::parse(&path, &src, "quick").unwrap();
         let section =
             sphrepro::automation::study::regenerate(&p, &tmp.path().join("out"), tmp.path()).unwrap();
         let figures = section
@@ -235,14 +99,14 @@ fn every_problem_plots_without_results() {
     assert!(svg.contains("Ghia et al. 1982"));
 }
 
-/// The dam-break problems: the presets the brief asks for, the fig. 17 times inside every
-/// preset's end time, normals drawn as arrows, the trade along dx as a spacing.
+/// The dam-break problems: the resolutions and end time of each preset, the fig. 17 times
+/// inside every preset's end time, normals drawn as arrows, the trade along dx as a spacing.
 #[test]
 fn dam_break_presets_figures_and_stability_sweep() {
     let load = |name: &str, preset: &str| {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("problems/{name}.toml"));
         let src = std::fs::read_to_string(&path).unwrap();
-        registry::parse_with(&path, &src, preset, find).unwrap()
+        registry::parse(&path, &src, preset).unwrap()
     };
     let dxs = |p: &registry::Problem| {
         let mut v: Vec<f64> = p.cases.iter().map(|c| c.params.float("dx")).collect();

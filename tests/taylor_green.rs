@@ -67,7 +67,7 @@ fn small_run_errors_stay_within_measured_bounds() {
 /// error follows the peer's, including where that is large. The state equation cannot hold
 /// the initial pressure of eq. (65), so both codes start from p = 0 and end tens of per cent
 /// off the exact solution, where `edac` ends within 2 %. PySPH's values were measured with
-/// `../shared/peers/pysph-taylor-green.sh --scheme tvf` (session 31); ours then agreed to
+/// `../shared/peers/pysph-taylor-green.sh --scheme tvf`; ours then agreed to
 /// 0.2 % (nx = 50), 1.9 % and 3.9 % (nx = 32). A tenth apart still tells the peer's scheme
 /// from the others: in the nx = 32 runs `edac` ends at 2.1 % and 9.0 %, `ctvf` with Sun's
 /// shifting at 6.5 % and 17.8 %.

@@ -1,24 +1,24 @@
-//! The throughput targets of issue 3 (README, "Throughput"), read off one sitting of `bench`:
-//! each target the sitting has the runs for, the measured ratio with its spread, and whether
-//! it holds. On a noisy host a median can sit on either side of a bound from sitting to
-//! sitting; the verdict then says the sitting cannot tell rather than pick a side.
+//! The throughput targets, read off one `bench` run: each target the run has the
+//! measurements for, the measured ratio with its spread, and whether it holds. On a noisy
+//! host a median can fall on either side of a bound from one run to the next; the verdict
+//! then says the run cannot tell rather than pick a side.
 //!
 //! - `edac` at nx = 50: at least 10x the peer (PySPH), at an L1 error no worse;
-//! - `edac` at nx = 200 and 400: at least 15x the peer's nx = 50 run (the issue's figure to
-//!   beat: its only peer figure, and 15 times it is about its own Rust prototype's 2.4 M;
-//!   the target as read since session 52), and, beside it, the stricter reading, 15x the
-//!   peer at the same size;
+//! - `edac` at nx = 200 and 400: at least 15x the peer's run at nx = 50; beside it, for
+//!   comparison and not as a target, the ratio to the peer at the same size;
 //! - the cost of a particle-step flat from nx = 50 to 400 (O(N));
 //! - two threads at least 1.7x one at nx >= 100;
 //! - `ctvf`+`ipst` within 3x the cost of `edac` a step.
 
-use super::{BenchResult, PeerResult, Ratio, FIGURE_TO_BEAT_NX};
+use super::case::BenchResult;
+use super::peer::{PeerResult, PEER_BASELINE_NX};
+use super::stats::Ratio;
 use serde::Serialize;
 
 /// Which side of its bound a target asks a measure to be on.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Bound {
+pub(super) enum Bound {
     /// At least this.
     AtLeast(f64),
     /// At most this.
@@ -43,23 +43,23 @@ impl std::fmt::Display for Bound {
     }
 }
 
-/// Whether a target holds in a sitting.
+/// Whether a target holds in one run of `bench`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
-pub enum Verdict {
+pub(super) enum Verdict {
     /// The whole 95 % interval of the median meets the bound, or, with no interval (fewer
     /// than six rounds, or a single measure), the value does.
     Met,
     /// The whole interval, or the value, misses it.
     Missed,
-    /// The interval straddles the bound: this sitting cannot tell.
+    /// The interval straddles the bound: this run cannot tell.
     Undecided,
 }
 
-/// One target on one case of a sitting.
+/// One target on one measured case.
 #[derive(Clone, Debug, Serialize)]
-pub struct TargetRow {
-    /// The target, as the issue states it.
+pub(super) struct TargetRow {
+    /// The target, in words.
     pub target: &'static str,
     /// Where it was measured (variant, size, threads, and what it is compared with).
     pub case: String,
@@ -67,7 +67,7 @@ pub struct TargetRow {
     pub measured: Ratio,
     /// The bound the target sets on it.
     pub bound: Bound,
-    /// Whether the sitting meets it.
+    /// Whether the measure meets it.
     pub verdict: Verdict,
 }
 
@@ -87,11 +87,11 @@ impl TargetRow {
 /// The largest exponent `e` of a cost growing as `N^e` that still counts as flat. Over the
 /// 64-fold growth of N from nx = 50 to 400 an O(N log N) cost would show `e` of about 0.10
 /// (`ln(ln 160000 / ln 2500) / ln 64`); 0.05 lies halfway between that and O(N).
-pub const FLAT_EXPONENT: f64 = 0.05;
+const FLAT_EXPONENT: f64 = 0.05;
 
 /// The least-squares slope of `ln(cost)` against `ln(N)` over the `(particles, particle-steps
 /// per second)` points: the exponent `e` of a cost a particle-step growing as `N^e`.
-pub fn cost_exponent(points: &[(usize, f64)]) -> f64 {
+fn cost_exponent(points: &[(usize, f64)]) -> f64 {
     let xy: Vec<(f64, f64)> = points.iter().map(|&(n, speed)| ((n as f64).ln(), -speed.ln())).collect();
     let k = xy.len() as f64;
     let (mx, my) = (xy.iter().map(|p| p.0).sum::<f64>() / k, xy.iter().map(|p| p.1).sum::<f64>() / k);
@@ -100,9 +100,9 @@ pub fn cost_exponent(points: &[(usize, f64)]) -> f64 {
     sxy / sxx
 }
 
-/// Every target the sitting's `results` and `peers` have the runs for, in the order of the
+/// Every target that `results` and `peers` have the runs for, in the order of the
 /// list above, each on every thread count measured.
-pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> {
+pub(super) fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> {
     let ours = |variant: &str, nx: usize, threads: usize, copies: usize| {
         results
             .iter()
@@ -117,10 +117,10 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
     sizes.dedup();
     let mut rows = Vec::new();
     for &t in &threads {
-        let (Some(e), Some(p)) = (ours("edac", FIGURE_TO_BEAT_NX, t, 1), peer(FIGURE_TO_BEAT_NX, t)) else {
+        let (Some(e), Some(p)) = (ours("edac", PEER_BASELINE_NX, t, 1), peer(PEER_BASELINE_NX, t)) else {
             continue;
         };
-        let case = format!("edac, nx = {FIGURE_TO_BEAT_NX}, {t} thread(s), against {}", p.peer);
+        let case = format!("edac, nx = {PEER_BASELINE_NX}, {t} thread(s), against {}", p.peer);
         rows.push(TargetRow::new(
             "edac at nx = 50: 10x the peer",
             case,
@@ -146,15 +146,16 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
     for &t in &threads {
         for nx in [200, 400] {
             let Some(e) = ours("edac", nx, t, 1) else { continue };
-            if let Some(p) = peer(FIGURE_TO_BEAT_NX, t) {
+            if let Some(p) = peer(PEER_BASELINE_NX, t) {
                 let case =
-                    format!("edac, nx = {nx}, {t} thread(s), against {} at nx = {FIGURE_TO_BEAT_NX}", p.peer);
-                let target = "edac at nx = 200, 400: 15x the figure to beat (the peer at nx = 50)";
+                    format!("edac, nx = {nx}, {t} thread(s), against {} at nx = {PEER_BASELINE_NX}", p.peer);
+                let target = "edac at nx = 200, 400: 15x the peer at nx = 50";
                 rows.push(TargetRow::new(target, case, Ratio::of(e, p), Bound::AtLeast(15.0)));
             }
             if let Some(p) = peer(nx, t) {
                 let case = format!("edac, nx = {nx}, {t} thread(s), against {} at nx = {nx}", p.peer);
-                let target = "edac at nx = 200, 400: 15x the peer at the same size (the stricter reading, not the target)";
+                let target =
+                    "edac at nx = 200, 400: 15x the peer at the same size (for comparison, not a target)";
                 rows.push(TargetRow::new(target, case, Ratio::of(e, p), Bound::AtLeast(15.0)));
             }
         }
@@ -196,9 +197,9 @@ pub fn targets(results: &[BenchResult], peers: &[PeerResult]) -> Vec<TargetRow> 
 }
 
 /// The rows as a Markdown table.
-pub fn table(rows: &[TargetRow]) -> String {
+pub(super) fn table(rows: &[TargetRow]) -> String {
     let mut s = String::from(
-        "| target (issue 3) | case | measured: median [95 % interval] (range) | bound | verdict |\n|---|---|---|---|---|\n",
+        "| target | case | measured: median [95 % interval] (range) | bound | verdict |\n|---|---|---|---|---|\n",
     );
     for r in rows {
         let verdict = match r.verdict {
@@ -224,7 +225,7 @@ pub fn table(rows: &[TargetRow]) -> String {
 
 #[cfg(test)]
 mod tests {
-    use super::super::peer_tests::sample;
+    use super::super::testutil::sample;
     use super::*;
 
     /// A configuration with its runs, the median run's throughput as its own.
@@ -290,8 +291,8 @@ mod tests {
         assert!((cost_exponent(&speeds(-0.02)) + 0.02).abs() < 1e-12);
     }
 
-    /// A sitting with the peer at nx = 50 and 400 and ours at both, on two threads: every
-    /// peer target, read round by round, and each reading of 15x on its own row.
+    /// A run with the peer at nx = 50 and 400 and ours at both, on two threads: every
+    /// peer target, read round by round, and both ratios at nx = 400 on rows of their own.
     #[test]
     fn peer_targets_compare_round_by_round() {
         let results = [
@@ -306,8 +307,8 @@ mod tests {
         assert_eq!(at_50.verdict, Verdict::Met);
         let l1 = find(&rows, "L1 error", "");
         assert!((l1.measured.median - 0.625).abs() < 1e-12 && l1.verdict == Verdict::Met);
-        // Against the figure to beat: 20, 14, 18; against the peer at nx = 400: 8, 8.4, 9.
-        let beat = find(&rows, "figure to beat", "nx = 400");
+        // Against the peer at nx = 50: 20, 14, 18; against the peer at nx = 400: 8, 8.4, 9.
+        let beat = find(&rows, "15x the peer at nx = 50", "nx = 400");
         assert_eq!((beat.measured.median, beat.verdict), (18.0, Verdict::Met));
         let same = find(&rows, "same size", "nx = 400");
         assert!((same.measured.median - 8.4).abs() < 1e-12 && same.verdict == Verdict::Missed);
@@ -329,7 +330,7 @@ mod tests {
             run("ctvf+ipst", 100, 2, 1, vec![1.0e6, 1.05e6, 1.1e6, 1.2e6, 1.1e6, 1.05e6]),
         ];
         let rows = targets(&results, &[]);
-        // No nx = 50 speed-up (the issue asks from nx = 100 on).
+        // No nx = 50 speed-up (the target is from nx = 100 on).
         assert!(rows
             .iter()
             .filter(|r| r.target.contains("two threads"))

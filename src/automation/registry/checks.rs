@@ -1,0 +1,453 @@
+//! The checks of figures, tables and bounds against the scene and the expanded cases: every
+//! selection picks a case, every metric is one the scene reports, every column one it
+//! writes, every label and swept `x` a parameter it has, and each figure kind has the keys
+//! it needs and no key of another kind.
+
+use super::expand::{check_param, resolve_raw, Expand, Raw};
+use super::model::{
+    glob_matches, valid_name, Bound, Case, Figure, FigureKind, Select, Table, DEFAULT_PRESET,
+};
+use super::reference;
+use super::schema::{BoundFile, FigureFile, Loc, RawParams, Span, TableFile};
+use crate::scenes::params::Value;
+use crate::scenes::SceneEntry;
+use std::collections::BTreeMap;
+use toml::Spanned;
+
+/// Checks that a selection matches at least one case.
+fn nonempty(
+    loc: &Loc,
+    span: Span,
+    what: &str,
+    s: &Select,
+    cases: &[Case],
+    preset: &str,
+) -> Result<(), String> {
+    if s.pick(cases).is_empty() {
+        let desc = format!(
+            "{}{}",
+            if s.cases.is_empty() { String::new() } else { format!("cases {:?} ", s.cases) },
+            if s.where_.is_empty() {
+                String::new()
+            } else {
+                format!(
+                    "where {}",
+                    s.where_.iter().map(|(k, v)| format!("{k} = {v}")).collect::<Vec<_>>().join(", ")
+                )
+            }
+        );
+        for g in &s.cases {
+            if !cases.iter().any(|c| glob_matches(g, &c.name).unwrap_or(false)) {
+                return Err(loc.err(span, what, format!("no case named `{g}` in preset `{preset}`")));
+            }
+        }
+        return Err(loc.err(span, what, format!("{desc} selects no case in preset `{preset}`")));
+    }
+    Ok(())
+}
+
+/// Checks that `m` is a metric the scene reports.
+fn check_metric(loc: &Loc, span: Span, what: &str, scene: &SceneEntry, m: &str) -> Result<(), String> {
+    if scene.metrics.contains(&m) {
+        Ok(())
+    } else {
+        Err(loc.err(
+            span,
+            what,
+            format!("scene `{}` has no metric `{m}`; its metrics: {}", scene.name, scene.metrics.join(", ")),
+        ))
+    }
+}
+
+impl Expand<'_> {
+    /// The cases a figure, table or bound selects: its globs, checked, and its `where`
+    /// table, of known parameters with values of the right type.
+    fn select(&self, cases: &[String], where_: &RawParams) -> Result<Select, String> {
+        let Expand { loc, scene, specs, preset, vars, .. } = *self;
+        let mut w = BTreeMap::new();
+        for (k, v) in where_ {
+            match resolve_raw(loc, k, v, vars, preset)? {
+                Raw::One(x) => {
+                    w.insert(k.clone(), check_param(loc, v.span(), scene, specs, k, &x)?);
+                }
+                Raw::List(_) => return Err(loc.err(v.span(), k, "a `where` value must be one value")),
+            }
+        }
+        for g in cases {
+            globset::Glob::new(g).map_err(|e| format!("{}: bad glob `{g}`: {e}", loc.path.display()))?;
+        }
+        Ok(Select { cases: cases.to_vec(), where_: w })
+    }
+
+    /// One figure, checked against the scene and the cases (`ids` holds the ids taken).
+    pub(super) fn figure(
+        &self,
+        f: &Spanned<FigureFile>,
+        cases: &[Case],
+        ids: &mut BTreeMap<String, usize>,
+    ) -> Result<Figure, String> {
+        let Expand { loc, scene, preset, .. } = *self;
+        let span = f.span();
+        let f = f.get_ref();
+        let key = format!("figures.{}", f.id);
+        claim_id(loc, span.clone(), &key, &f.id, ids)?;
+        let select = self.select(&f.cases, &f.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
+        for l in &f.label {
+            self.parameter(span.clone(), &key, "label", l)?;
+        }
+        if let Some(m) = &f.metric {
+            check_metric(loc, span.clone(), &key, scene, m)?;
+        }
+        let kind = self.figure_kind(f, span.clone(), &key, &select, cases)?;
+        // Keys that only one kind reads: set on another, they would be silently ignored.
+        for (k, set, only) in [
+            ("file", f.file.is_some(), "profile"),
+            ("reference", f.reference.is_some(), "profile"),
+            ("x_label", f.x_label.is_some(), "profile"),
+            ("time", f.time.is_some(), "particles"),
+            ("arrows", f.arrows.is_some(), "particles"),
+            ("x_spacing", f.x_spacing, "trade"),
+        ] {
+            if set && f.kind != only {
+                return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `{only}` takes `{k}`")));
+            }
+        }
+        if (f.converges || f.lower.is_some()) && f.metric.is_none() {
+            return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
+        }
+        if f.converges && f.label.is_empty() {
+            return Err(loc.err(span, &key, "`converges` needs `label` (the resolution last)"));
+        }
+        let lower_than = match (&f.lower, &f.higher) {
+            (Some(a), Some(b)) => {
+                let a = self.select(&a.cases, &a.where_)?;
+                let b = self.select(&b.cases, &b.where_)?;
+                nonempty(loc, span.clone(), &format!("{key}.lower"), &a, cases, preset)?;
+                nonempty(loc, span.clone(), &format!("{key}.higher"), &b, cases, preset)?;
+                Some((a, b))
+            }
+            (None, None) => None,
+            _ => return Err(loc.err(span, &key, "`lower` and `higher` go together")),
+        };
+        Ok(Figure {
+            id: f.id.clone(),
+            kind,
+            title: f.title.clone(),
+            caption: f.caption.clone(),
+            paper: f.paper.clone(),
+            select,
+            x_label: f.x_label.clone(),
+            y_label: f.y_label.clone(),
+            log_y: f.log_y,
+            metric: f.metric.clone(),
+            label: f.label.clone(),
+            converges: f.converges,
+            lower_than,
+        })
+    }
+
+    /// What figure `f` draws (its `kind` and the keys that kind needs), checked.
+    fn figure_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        select: &Select,
+        cases: &[Case],
+    ) -> Result<FigureKind, String> {
+        let need = |what: &str, v: &Option<String>| {
+            v.clone()
+                .ok_or_else(|| self.loc.err(span.clone(), key, format!("kind `{}` needs `{what}`", f.kind)))
+        };
+        Ok(match f.kind.as_str() {
+            "timeseries" => self.timeseries_kind(f, span.clone(), key, need("y", &f.y)?)?,
+            "particles" => {
+                self.particles_kind(f, span.clone(), key, select, cases, need("field", &f.field)?)?
+            }
+            "trade" => {
+                need("metric", &f.metric)?;
+                FigureKind::Trade {
+                    x: self.swept(span.clone(), key, need("x", &f.x)?)?,
+                    spacing: f.x_spacing,
+                }
+            }
+            "stability" => {
+                need("metric", &f.metric)?;
+                let x = self.swept(span.clone(), key, need("x", &f.x)?)?;
+                let max =
+                    f.max.ok_or_else(|| self.loc.err(span.clone(), key, "kind `stability` needs `max`"))?;
+                FigureKind::Stability { x, max }
+            }
+            "profile" => {
+                let file_name = need("file", &f.file)?;
+                if !valid_name(&file_name) || file_name.starts_with('.') {
+                    return Err(self.loc.err(
+                        span.clone(),
+                        &format!("{key}.file"),
+                        format!("`{file_name}` must be a file name in the case folder (letters, digits, `.`, `_`, `-`)"),
+                    ));
+                }
+                let reference = match &f.reference {
+                    Some(r) => Some(reference::read(self.loc, r.span(), key, r.get_ref())?),
+                    None => None,
+                };
+                FigureKind::Profile { file: file_name, x: need("x", &f.x)?, y: need("y", &f.y)?, reference }
+            }
+            other => {
+                return Err(self.loc.err(
+                    span.clone(),
+                    key,
+                    format!(
+                        "unknown kind `{other}`; kinds: timeseries, particles, trade, stability, profile"
+                    ),
+                ))
+            }
+        })
+    }
+
+    /// A `timeseries` figure of column `y`: it and the exact column are columns the scene
+    /// writes.
+    fn timeseries_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        y: String,
+    ) -> Result<FigureKind, String> {
+        let scene = self.scene;
+        for (what, c) in [("y", Some(&y)), ("exact", f.exact.as_ref())] {
+            if let Some(c) = c.filter(|c| !scene.columns.contains(&c.as_str())) {
+                return Err(self.loc.err(
+                    span,
+                    &format!("{key}.{what}"),
+                    format!(
+                        "scene `{}` has no time-series column `{c}`; its columns: {}",
+                        scene.name,
+                        scene.columns.join(", ")
+                    ),
+                ));
+            }
+        }
+        Ok(FigureKind::Timeseries { y, exact: f.exact.clone() })
+    }
+
+    /// A `particles` figure of point array `field`: its `time` is one every selected case
+    /// reaches, and `arrows` a point array name.
+    fn particles_kind(
+        &self,
+        f: &FigureFile,
+        span: Span,
+        key: &str,
+        select: &Select,
+        cases: &[Case],
+        field: String,
+    ) -> Result<FigureKind, String> {
+        let (loc, preset) = (self.loc, self.preset);
+        if let Some(t) = f.time {
+            if !(t.is_finite() && t >= 0.0) {
+                return Err(loc.err(span, &format!("{key}.time"), format!("`{t}` is not a time >= 0")));
+            }
+            // A snapshot after the end time does not exist: the figure would silently show
+            // another time. Every preset is checked.
+            let picked = select.pick(cases);
+            if let Some(c) =
+                picked.iter().find(|c| matches!(c.params.0.get("tf"), Some(Value::Float(tf)) if *tf < t))
+            {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.time"),
+                    format!(
+                        "t = {t} is after the end time tf = {} of case `{}` in preset `{preset}`",
+                        c.params.0["tf"], c.name
+                    ),
+                ));
+            }
+        }
+        if let Some(a) = &f.arrows {
+            if a.is_empty() || a.contains(['"', '<', '>']) {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.arrows"),
+                    format!("`{a}` is not a point array name"),
+                ));
+            }
+        }
+        Ok(FigureKind::Particles { field, time: f.time, arrows: f.arrows.clone() })
+    }
+
+    /// The swept parameter `x` of a `trade` or `stability` figure: one the scene has.
+    fn swept(&self, span: Span, key: &str, x: String) -> Result<String, String> {
+        self.parameter(span, key, "x", &x)?;
+        Ok(x)
+    }
+
+    /// Checks that `name`, given as `what` under `key`, is a parameter of the scene (a
+    /// figure's labels and swept `x`, a table's columns).
+    fn parameter(&self, span: Span, key: &str, what: &str, name: &str) -> Result<(), String> {
+        if !self.specs.iter().any(|s| s.name == name) {
+            return Err(self.loc.err(span, key, format!("`{what}` names no parameter `{name}`")));
+        }
+        Ok(())
+    }
+
+    /// One table, checked against the scene and the cases (`ids` holds the ids taken).
+    pub(super) fn table(
+        &self,
+        t: &Spanned<TableFile>,
+        cases: &[Case],
+        ids: &mut BTreeMap<String, usize>,
+    ) -> Result<Table, String> {
+        let Expand { loc, scene, preset, .. } = *self;
+        let span = t.span();
+        let t = t.get_ref();
+        let key = format!("tables.{}", t.id);
+        claim_id(loc, span.clone(), &key, &t.id, ids)?;
+        let select = self.select(&t.cases, &t.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
+        for m in &t.metrics {
+            check_metric(loc, span.clone(), &key, scene, m)?;
+        }
+        for c in &t.columns {
+            self.parameter(span.clone(), &key, "columns", c)?;
+        }
+        Ok(Table {
+            id: t.id.clone(),
+            title: t.title.clone(),
+            caption: t.caption.clone(),
+            select,
+            columns: t.columns.clone(),
+            metrics: t.metrics.clone(),
+        })
+    }
+
+    /// One bound, checked against the scene and the cases; `None` if it does not hold in
+    /// this preset.
+    pub(super) fn bound(&self, b: &Spanned<BoundFile>, cases: &[Case]) -> Result<Option<Bound>, String> {
+        let Expand { loc, file, scene, preset, .. } = *self;
+        let span = b.span();
+        let b = b.get_ref();
+        let key = format!("bounds.{}", b.metric);
+        check_metric(loc, span.clone(), "bounds.metric", scene, &b.metric)?;
+        if b.max.is_none() && b.min.is_none() {
+            return Err(loc.err(span, &key, "a bound needs `max` or `min`"));
+        }
+        if let (Some(lo), Some(hi)) = (b.min, b.max) {
+            if lo > hi {
+                return Err(loc.err(
+                    span,
+                    &key,
+                    format!("min = {lo} is above max = {hi}: no value can hold"),
+                ));
+            }
+        }
+        let presets = b.presets.clone().unwrap_or_else(|| vec![DEFAULT_PRESET.to_string()]);
+        for p in &presets {
+            if !file.presets.contains_key(p) {
+                return Err(loc.err(span, &key, format!("no preset `{p}`")));
+            }
+        }
+        if !presets.iter().any(|p| p == preset) {
+            return Ok(None);
+        }
+        let select = self.select(&b.cases, &b.where_)?;
+        nonempty(loc, span.clone(), &key, &select, cases, preset)?;
+        Ok(Some(Bound {
+            metric: b.metric.clone(),
+            select,
+            max: b.max,
+            min: b.min,
+            presets,
+            line: loc.line(span.start),
+        }))
+    }
+}
+
+/// Takes `id` for a figure or a table: a name their files can carry (it becomes
+/// `figures/ID.png` or `tables/ID.md`, so no path), not taken by another figure or table of
+/// the problem (`ids`: each id taken, with its line).
+fn claim_id(
+    loc: &Loc,
+    span: Span,
+    key: &str,
+    id: &str,
+    ids: &mut BTreeMap<String, usize>,
+) -> Result<(), String> {
+    if !valid_name(id) {
+        return Err(loc.err(span, key, "an id may use letters, digits, `.`, `_` and `-` only"));
+    }
+    if let Some(l) = ids.insert(id.to_string(), loc.line(span.start)) {
+        return Err(loc.err(span, key, format!("a figure or table on line {l} has the same id")));
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::testutil::{p, GOOD};
+
+    #[test]
+    fn selection_metric_and_id_errors_name_file_line_and_key() {
+        let e = p(&GOOD.replace("\"sun-*\"", "\"nope\"")).unwrap_err();
+        assert!(e.contains("nope") && e.contains("x.toml:1"), "{e}");
+        let e =
+            p(&GOOD.replace("metric = \"l1_velocity_final\"\nlabel", "metric = \"l2\"\nlabel")).unwrap_err();
+        assert!(e.contains("l2"), "{e}");
+        // Figure and table ids name files: a path is refused, and so is an id taken twice.
+        let table = |id: &str| {
+            format!("{GOOD}[[tables]]\nid = \"{id}\"\ntitle = \"t\"\nmetrics = [\"l1_velocity_final\"]\n")
+        };
+        assert!(p(&table("t1")).is_ok());
+        let e = p(&table("../t1")).unwrap_err();
+        assert!(
+            e.starts_with("x.toml:") && e.contains("`tables.../t1`") && e.contains("an id may use"),
+            "{e}"
+        );
+        let e = p(&table("f1")).unwrap_err();
+        assert!(e.contains("`tables.f1`") && e.contains("has the same id"), "{e}");
+        let e = p(&GOOD.replace("id = \"f1\"", "id = \"a/f1\"")).unwrap_err();
+        assert!(e.contains("`figures.a/f1`") && e.contains("an id may use"), "{e}");
+    }
+
+    /// Each figure kind's own keys: what it needs, what it checks, and keys of another kind
+    /// refused rather than ignored.
+    #[test]
+    fn figure_kinds_check_their_keys() {
+        let kind = |k: &str, extra: &str| {
+            GOOD.replace("kind = \"timeseries\"", &format!("kind = \"{k}\"{extra}"))
+                .replace("y = \"u_max\"\n", "")
+        };
+        for k in ["trade", "stability"] {
+            let e = p(&kind(k, "")).unwrap_err();
+            assert!(e.starts_with("x.toml:") && e.contains("`figures.f1`") && e.contains("needs `x`"), "{e}");
+            let e = p(&kind(k, "\nx = \"nz\"\nmax = 0.1")).unwrap_err();
+            assert!(e.contains("`x` names no parameter `nz`"), "{e}");
+        }
+        assert!(p(&kind("trade", "\nx = \"nx\"")).is_ok());
+        let e = p(&kind("stability", "\nx = \"nx\"")).unwrap_err();
+        assert!(e.contains("kind `stability` needs `max`"), "{e}");
+        assert!(p(&kind("stability", "\nx = \"nx\"\nmax = 0.1")).is_ok());
+        let e = p(&kind("particles", "")).unwrap_err();
+        assert!(e.contains("needs `field`"), "{e}");
+        assert!(p(&kind("particles", "\nfield = \"p\"\ntime = 0.01")).is_ok());
+        let e = p(&kind("particles", "\nfield = \"p\"\ntime = 0.5")).unwrap_err();
+        assert!(e.contains("`figures.f1.time`") && e.contains("after the end time"), "{e}");
+        let e = p(&kind("particles", "\nfield = \"p\"\ntime = -1.0")).unwrap_err();
+        assert!(e.contains("not a time >= 0"), "{e}");
+        let e = p(&kind("particles", "\nfield = \"p\"\narrows = \"<n>\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.arrows`"), "{e}");
+        let e = p(&GOOD.replace("y = \"u_max\"", "y = \"vorticity\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.y`") && e.contains("no time-series column `vorticity`"), "{e}");
+        for (extra, only) in [
+            ("time = 0.01", "particles"),
+            ("arrows = \"n\"", "particles"),
+            ("x_spacing = true", "trade"),
+            ("x_label = \"u\"", "profile"),
+        ] {
+            let e = p(&GOOD.replace("y = \"u_max\"", &format!("y = \"u_max\"\n{extra}"))).unwrap_err();
+            assert!(e.contains(&format!("only kind `{only}` takes")), "{extra}: {e}");
+        }
+        let e = p(&kind("bars", "")).unwrap_err();
+        assert!(e.contains("unknown kind `bars`") && e.contains("timeseries, particles"), "{e}");
+    }
+}

@@ -1,0 +1,245 @@
+//! The resolved model of a problem, as the rest of the crate uses it: a [`Problem`] with its
+//! [`Case`]s (every parameter resolved) for one preset, the [`Figure`]s and [`Table`]s it
+//! regenerates and the [`Bound`]s `check` enforces, each picking its cases with a
+//! [`Select`].
+
+use crate::scenes::params::{Params, Value};
+use crate::scenes::SceneEntry;
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// The preset used when none is named.
+pub const DEFAULT_PRESET: &str = "quick";
+
+/// One simulation: a scene with every parameter resolved.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Name, unique within its problem (letters, digits, `.`, `_`, `-`).
+    pub name: String,
+    /// Scene name.
+    pub scene: String,
+    /// Every declared parameter, defaults filled in.
+    pub params: Params,
+}
+
+/// Which cases a figure, table or bound is about: names (globs) and parameter values; a
+/// case is selected when it matches one of the globs (or there are none) and every value.
+#[derive(Clone, Debug, Default)]
+pub struct Select {
+    /// Globs over case names (empty: every case).
+    pub cases: Vec<String>,
+    /// Parameter values the case must have.
+    pub where_: BTreeMap<String, Value>,
+}
+
+impl Select {
+    /// Whether `case` is selected.
+    pub fn matches(&self, case: &Case) -> bool {
+        let by_name =
+            self.cases.is_empty() || self.cases.iter().any(|g| glob_matches(g, &case.name).unwrap_or(false));
+        by_name && self.where_.iter().all(|(k, v)| case.params.0.get(k).is_some_and(|c| values_equal(c, v)))
+    }
+
+    /// The selected cases, in problem order.
+    pub fn pick<'a>(&self, cases: &'a [Case]) -> Vec<&'a Case> {
+        cases.iter().filter(|c| self.matches(c)).collect()
+    }
+}
+
+/// Whether `name` matches the glob `pattern`.
+pub fn glob_matches(pattern: &str, name: &str) -> Result<bool, String> {
+    globset::Glob::new(pattern)
+        .map(|g| g.compile_matcher().is_match(name))
+        .map_err(|e| format!("bad glob `{pattern}`: {e}"))
+}
+
+/// Whether two parameter values are equal, an integer equal to a float of the same value.
+fn values_equal(a: &Value, b: &Value) -> bool {
+    match (a, b) {
+        (Value::Float(x), Value::Int(i)) | (Value::Int(i), Value::Float(x)) => *x == *i as f64,
+        _ => a == b,
+    }
+}
+
+/// What a figure draws.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FigureKind {
+    /// A `timeseries.csv` column against `t`, one curve per case, with an optional exact
+    /// curve (dashed) from the first case.
+    Timeseries {
+        /// Column drawn.
+        y: String,
+        /// Column holding the exact solution.
+        exact: Option<String>,
+    },
+    /// The particles of one case's snapshot (the last one, or the one nearest `time`),
+    /// coloured by a point array, with an optional vector array drawn as short segments.
+    Particles {
+        /// Point array (e.g. `pressure`).
+        field: String,
+        /// Simulated time of the snapshot drawn (the nearest listed in `fluid.pvd`);
+        /// `None`: the last snapshot.
+        time: Option<f64>,
+        /// A 3-component point array (e.g. `normal`) drawn as segments about one particle
+        /// spacing long at the particles where it is non-zero.
+        arrows: Option<String>,
+    },
+    /// Error against cost (wall time and particle-steps) with the Pareto front, and the
+    /// same as a table with the observed orders of convergence along `x`.
+    Trade {
+        /// The resolution parameter (e.g. `nx`); h is taken as `1 / x`, or as `x` when
+        /// `spacing` (e.g. `dx`).
+        x: String,
+        /// `x` is a spacing (h = x) rather than a count (h = 1 / x).
+        spacing: bool,
+    },
+    /// Outcome map (stable / inaccurate / diverged) of the curve groups against parameter
+    /// `x`, and the same as a table.
+    Stability {
+        /// Swept parameter.
+        x: String,
+        /// Above this value of the metric a case that completed is inaccurate.
+        max: f64,
+    },
+    /// Column `y` against column `x` of a CSV file in each case folder (e.g. a velocity
+    /// profile written at the end of the run), one curve per case, with optional
+    /// published points.
+    Profile {
+        /// File name in the case folder (e.g. `centerline_u.csv`).
+        file: String,
+        /// Column on the horizontal axis.
+        x: String,
+        /// Column on the vertical axis.
+        y: String,
+        /// Published points drawn as markers.
+        reference: Option<Reference>,
+    },
+}
+
+/// Published points of a [`FigureKind::Profile`], read and checked when the problem file
+/// is loaded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reference {
+    /// The CSV file (under `reference_data/`).
+    pub path: PathBuf,
+    /// Legend entry.
+    pub label: String,
+    /// Column on the horizontal axis.
+    pub x_column: String,
+    /// Column on the vertical axis.
+    pub y_column: String,
+    /// Its values, one per row.
+    pub x: Vec<f64>,
+    /// Its values, one per row.
+    pub y: Vec<f64>,
+}
+
+/// A figure a problem regenerates.
+#[derive(Clone, Debug)]
+pub struct Figure {
+    /// File stem, named after the paper (e.g. `fig06a_tg_decay_sun_re100`).
+    pub id: String,
+    /// What it draws.
+    pub kind: FigureKind,
+    /// Title.
+    pub title: String,
+    /// Caption in the manuscript.
+    pub caption: String,
+    /// What the paper shows, for the manuscript's comparison line.
+    pub paper: String,
+    /// Cases drawn.
+    pub select: Select,
+    /// X-axis label (with units; `profile` only).
+    pub x_label: Option<String>,
+    /// Y-axis label (with units).
+    pub y_label: Option<String>,
+    /// Logarithmic y axis.
+    pub log_y: bool,
+    /// The summary metric reported in the manuscript (and drawn by trade and stability).
+    pub metric: Option<String>,
+    /// Parameters naming each curve (or each row of a stability map).
+    pub label: Vec<String>,
+    /// The paper's claim: the metric decreases as the last `label` parameter grows.
+    pub converges: bool,
+    /// The paper's claim: the `lower` cases have a smaller metric than the `higher` ones.
+    pub lower_than: Option<(Select, Select)>,
+}
+
+/// A table of summary values.
+#[derive(Clone, Debug)]
+pub struct Table {
+    /// File stem.
+    pub id: String,
+    /// Title.
+    pub title: String,
+    /// Caption.
+    pub caption: String,
+    /// Rows.
+    pub select: Select,
+    /// Parameter columns.
+    pub columns: Vec<String>,
+    /// Metric columns.
+    pub metrics: Vec<String>,
+}
+
+/// A bound `check` enforces.
+#[derive(Clone, Debug)]
+pub struct Bound {
+    /// Metric.
+    pub metric: String,
+    /// Cases it applies to.
+    pub select: Select,
+    /// Largest accepted value.
+    pub max: Option<f64>,
+    /// Smallest accepted value.
+    pub min: Option<f64>,
+    /// Presets it applies to (bounds are measured on one).
+    pub presets: Vec<String>,
+    /// Line in the problem file.
+    pub line: usize,
+}
+
+/// A problem: one paper benchmark, with its cases expanded for one preset.
+#[derive(Clone)]
+pub struct Problem {
+    /// File stem, used as the output folder name.
+    pub name: String,
+    /// Problem file.
+    pub path: PathBuf,
+    /// Title.
+    pub title: String,
+    /// Description (Markdown), for the manuscript.
+    pub description: String,
+    /// Scene.
+    pub scene: &'static SceneEntry,
+    /// Preset the cases were expanded for.
+    pub preset: String,
+    /// The cases each other preset of the file expands to (by preset name), so that their
+    /// results are known for what they are.
+    pub other_presets: Vec<(String, Vec<Case>)>,
+    /// Cases of this preset.
+    pub cases: Vec<Case>,
+    /// Figures.
+    pub figures: Vec<Figure>,
+    /// Tables.
+    pub tables: Vec<Table>,
+    /// Bounds that apply to this preset.
+    pub bounds: Vec<Bound>,
+}
+
+impl std::fmt::Debug for Problem {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Problem")
+            .field("name", &self.name)
+            .field("scene", &self.scene.name)
+            .field("preset", &self.preset)
+            .field("cases", &self.cases)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Whether `s` may name a problem file, a case, a figure or table id, or a file in a case
+/// folder: letters, digits, `.`, `_` and `-` only (no path).
+pub(super) fn valid_name(s: &str) -> bool {
+    !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'))
+}
