@@ -1,8 +1,8 @@
 //! sphrepro reproduces SPH research papers with one command.
 //!
 //! Two halves, three layers (`automation -> scenes -> solver`, never the reverse):
-//! - [`solver`]: the SPH library (kernels, neighbour search, particles, one function per
-//!   physics term, schemes as ordered passes, kick-drift-kick integration, output);
+//! - [`solver`]: the SPH library (bodies as systems, who acts on whom, one function per
+//!   physics term, schemes, the parallel passes, kick-drift-kick integration, output);
 //! - [`scenes`]: one module per benchmark geometry, declaring its parameters and metrics;
 //! - the command line (`src/main.rs`) and the automation framework that runs problems
 //!   from `problems/*.toml` and regenerates the manuscript.
@@ -16,3 +16,8 @@ pub mod automation;
 pub mod bench;
 pub mod scenes;
 pub mod solver;
+
+/// The README's Rust example, compiled and run as a doc test.
+#[doc = include_str!("../README.md")]
+#[cfg(doctest)]
+pub struct ReadmeDoctests;
