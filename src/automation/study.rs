@@ -840,6 +840,7 @@ paper = "Fig. 14a"
             scene: "taylor_green".into(),
             params,
             particles,
+            bodies: BTreeMap::from([("fluid".to_string(), particles)]),
             steps: 10,
             final_time: 1.0,
             wall_seconds: 0.1,

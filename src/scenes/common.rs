@@ -428,6 +428,9 @@ macro_rules! forward_to_sim {
         fn particles(&self) -> usize {
             $crate::scenes::common::particle_count(&self.sim)
         }
+        fn body_particles(&self) -> Vec<(String, usize)> {
+            $crate::scenes::common::body_particles(&self.sim)
+        }
         fn time(&self) -> f64 {
             self.sim.time()
         }
@@ -469,6 +472,18 @@ pub fn plan<const D: usize>(sim: &Simulation<D>, setting: &str) -> String {
         }
     }
     format!("{}, kernel {:?} ({setting})\n{}", bodies.join("; "), sim.kernel.kind(), sim.fluid().physics)
+}
+
+/// The particles of each body of `sim` (each part of the fluid apart), by name.
+pub fn body_particles<const D: usize>(sim: &Simulation<D>) -> Vec<(String, usize)> {
+    let mut out = Vec::new();
+    for body in sim.bodies() {
+        match body {
+            Body::Fluid(f) => out.extend(f.parts.iter().map(|p| (p.name.clone(), p.ids.len()))),
+            Body::Wall(w) => out.push((w.name.clone(), w.len())),
+        }
+    }
+    out
 }
 
 /// Particles in every body of `sim`.

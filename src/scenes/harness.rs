@@ -317,6 +317,7 @@ fn summary(
         scene: entry.name.into(),
         params: params.to_json(),
         particles,
+        bodies: scene.body_particles().into_iter().collect(),
         steps,
         final_time: scene.time(),
         wall_seconds: t0.elapsed().as_secs_f64(),

@@ -25,6 +25,8 @@ use std::path::Path;
 pub trait SceneRun {
     /// Particles in all bodies.
     fn particles(&self) -> usize;
+    /// Particles of each body, by name.
+    fn body_particles(&self) -> Vec<(String, usize)>;
     /// Simulated time.
     fn time(&self) -> f64;
     /// Steps taken.

@@ -79,6 +79,10 @@ pub struct Summary {
     pub params: BTreeMap<String, serde_json::Value>,
     /// Particle count (all bodies).
     pub particles: usize,
+    /// Particles of each body, by name (empty in summaries written before bodies were
+    /// counted apart).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub bodies: BTreeMap<String, usize>,
     /// Time steps taken.
     pub steps: u64,
     /// Simulated time reached.
