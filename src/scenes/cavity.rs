@@ -17,7 +17,7 @@
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim,
     scheme_params, shepard, shifting_columns, snapshot_bodies, time_settings, wall_density, wall_from,
-    wall_params, wall_pressure, FluidConstants,
+    wall_params, wall_pressure, wall_viscosity, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -115,8 +115,11 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let re = p.float("re");
     let fluid = fluid_at_rest(lattice(0.0, L, 0.0, L, dx), dx, RHO0, h, scheme, |_| 0.0)?;
     let lid = |x: &Vector<2>| if x[1] > L { Vector::<2>::new(U, 0.0) } else { Vector::zeros() };
-    let wall = wall_from(&box_walls(L, L, dx, LAYERS, true), lid, dx, RHO0, C0)?
-        .with_models(wall_density(p), wall_pressure(p));
+    let wall = wall_from(&box_walls(L, L, dx, LAYERS, true), lid, dx, RHO0, C0)?.with_models(
+        wall_density(p),
+        wall_pressure(p),
+        wall_viscosity(p),
+    );
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
     let time = time_settings(p);

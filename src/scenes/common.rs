@@ -7,11 +7,11 @@ use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::output::vtu::{write_vtu, Field};
 use crate::solver::scheme::{
-    paper, Corrections, DensityModel, FluidScheme, FluidSettings, OptionError, PressureReference, Pst,
-    SchemeName, SchemeOptions, SurfacePressure,
+    paper, Corrections, DensityModel, FluidScheme, FluidSettings, IpstTest, OptionError, PressureReference,
+    Pst, SchemeName, SchemeOptions, SurfaceCone, SurfacePressure,
 };
 use crate::solver::simulation::{Simulation, TimeSettings};
-use crate::solver::systems::{Body, Fluid, FluidInit, Wall, WallDensity, WallPressure};
+use crate::solver::systems::{Body, Fluid, FluidInit, Wall, WallDensity, WallPressure, WallViscosity};
 use std::path::Path;
 
 const SWITCH: &[&str] = &["auto", "on", "off"];
@@ -62,17 +62,33 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             1,
             "IPST on every this many steps, no homogenisation in between (the paper: 1; the authors' code: 5)",
         ),
+        Spec::choice(
+            "ipst_test",
+            IpstTest::NAMES,
+            "two_sided",
+            "which deviation of the largest chi from its reference fails IPST's test, eq. (39): either (as printed) or only an excess",
+        )
+        .added_later(),
     ]
 }
 
 /// The parameters of a scene with a free surface (on top of [`scheme_params`]).
 pub fn free_surface_params() -> Vec<Spec> {
-    vec![Spec::choice(
-        "surface_pressure",
-        SurfacePressure::NAMES,
-        "evolve",
-        "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), held at 0 where isolated, or evolved but not below 0",
-    )]
+    vec![
+        Spec::choice(
+            "surface_pressure",
+            SurfacePressure::NAMES,
+            "evolve",
+            "pressure of the free-surface particles: evolved by eq. (26), held at 0 (p = p_atm), held at 0 where isolated, or evolved but not below 0",
+        ),
+        Spec::choice(
+            "surface_cone",
+            SurfaceCone::NAMES,
+            "support",
+            "neighbours of the 60-degree test of the free-surface detection: the whole support with the walls, or the fluid within 2h (the authors' code)",
+        )
+        .added_later(),
+    ]
 }
 
 /// The time loop's settings from the common parameters (`cfl`, `rate_positions`).
@@ -170,6 +186,8 @@ pub fn scheme_options(p: &Params, given: impl Fn(&str) -> bool) -> Option<(Schem
         ipst_tol: given("ipst_tol").then(|| p.float("ipst_tol")),
         ipst_max_iter: given("ipst_max_iter").then(|| p.int("ipst_max_iter") as usize),
         ipst_interval: given("ipst_interval").then(|| p.int("ipst_interval") as usize),
+        ipst_test: given("ipst_test")
+            .then(|| IpstTest::from_name(p.str("ipst_test")).expect("checked choice")),
         edac_alpha: given("edac_alpha").then(|| p.float("edac_alpha")),
     };
     Some((scheme, pst, options))
@@ -269,6 +287,11 @@ pub fn fluid_scheme<const D: usize>(
             SurfacePressure::from_name(p.str("surface_pressure"))
                 .expect("checked choice (free_surface_params)")
         }),
+        surface_cone: match p.0.get("surface_cone") {
+            Some(_) => SurfaceCone::from_name(p.str("surface_cone")).expect("checked choice"),
+            None => SurfaceCone::default(),
+        },
+        ipst_test: IpstTest::from_name(p.str("ipst_test")).expect("checked choice"),
     };
     let scheme = SchemeName::from_name(p.str("scheme")).expect("checked choice").fluid_scheme(&settings);
     Ok((kernel, h, scheme))
@@ -597,6 +620,11 @@ pub fn wall_pressure(p: &Params) -> WallPressure {
     WallPressure::from_name(p.str("wall_pressure")).expect("checked choice (wall_params)")
 }
 
+/// The velocity the walls present to the artificial viscosity (see [`wall_params`]).
+pub fn wall_viscosity(p: &Params) -> WallViscosity {
+    WallViscosity::from_name(p.str("wall_viscosity")).expect("checked choice (wall_params)")
+}
+
 /// The parameters of a scene with walls.
 pub fn wall_params() -> Vec<Spec> {
     vec![
@@ -611,6 +639,13 @@ pub fn wall_params() -> Vec<Spec> {
             WallPressure::NAMES,
             "extrapolated",
             "pressure of the wall particles: eq. (52) as it stands, or clamped at zero so that walls never pull the fluid (PySPH's ClampWallPressure)",
+        )
+        .added_later(),
+        Spec::choice(
+            "wall_viscosity",
+            WallViscosity::NAMES,
+            "no_slip",
+            "velocity the artificial viscosity sees on a wall: the no-slip ghost velocity of eq. (50), or the wall's own (PySPH, the authors' code)",
         )
         .added_later(),
     ]

@@ -6,7 +6,7 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, require_free_surface_scheme, wall_density,
-    wall_from, wall_pressure, FluidConstants,
+    wall_from, wall_pressure, wall_viscosity, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::Params;
@@ -79,7 +79,7 @@ impl Column {
         let hydrostatic = |x: &Vector<2>| RHO0 * g * (height - x[1]);
         let fluid = fluid_at_rest(lattice(0.0, width, 0.0, height, dx), dx, RHO0, h, physics, hydrostatic)?;
         let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
-            .with_models(wall_density(p), wall_pressure(p));
+            .with_models(wall_density(p), wall_pressure(p), wall_viscosity(p));
         Ok((fluid, wall))
     }
 }

@@ -644,7 +644,7 @@ impl<const D: usize> Simulation<D> {
             let fluid = self.state.bodies[f].as_fluid().expect("the fluid");
             let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &self.state.bodies);
             let nl = &self.couplings.fluid_fluid.list;
-            fs.detect(Particles::of(fluid), nl, boundaries, free.rho0);
+            fs.detect(Particles::of(fluid), nl, boundaries, free.rho0, free.cone);
             let fluid = self.state.bodies[f].as_fluid_mut().expect("the fluid");
             fs.apply_surface_pressure(free.pressure, free.rho0, &mut fluid.p);
             if free.pressure != SurfacePressure::Evolve {

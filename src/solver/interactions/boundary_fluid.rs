@@ -56,26 +56,25 @@ impl<const D: usize> BoundaryFluid<D> {
                 (Velocity::Uniform(*velocity), *acceleration, false)
             }
         };
-        let BoundaryModel { m, material, ghost: ghosts, rho, div, visc } = boundary;
+        let BoundaryModel { m, material, ghost: ghosts, rho, div, visc, av } = boundary;
         let (material, m) = (*material, &m[..]);
         assert!(ghosts.len() == x.len(), "the boundary's values are sized for its particles");
-        ghosts
-            .par_iter_mut()
-            .zip(rho.par_iter_mut().zip(div.par_iter_mut().zip(visc.par_iter_mut())))
-            .enumerate()
-            .for_each(|(i, (out, (rho, (div, visc))))| {
-                let mut s = WallSums::default();
-                list.for_each_from(i, x[i], &fluid.x, |j, x_wf, _, &w| {
-                    s.add(w, x_wf, fluid.p[j], fluid.rho[j], fluid.u[j], u_hat[j]);
-                });
-                let u_p = match velocity {
-                    Velocity::PerParticle(u) => u[i],
-                    Velocity::Uniform(u) => u,
-                };
-                *out = ghost(&s, u_p, sliding, acceleration, normal[i], g);
-                out.p = material.pressure.apply(out.p);
-                (*rho, *div, *visc) = material.present(m[i], out);
+        let views =
+            rho.par_iter_mut().zip(div.par_iter_mut()).zip(visc.par_iter_mut().zip(av.par_iter_mut()));
+        ghosts.par_iter_mut().zip(views).enumerate().for_each(|(i, (out, ((rho, div), (visc, av))))| {
+            let mut s = WallSums::default();
+            list.for_each_from(i, x[i], &fluid.x, |j, x_wf, _, &w| {
+                s.add(w, x_wf, fluid.p[j], fluid.rho[j], fluid.u[j], u_hat[j]);
             });
+            let u_p = match velocity {
+                Velocity::PerParticle(u) => u[i],
+                Velocity::Uniform(u) => u,
+            };
+            *out = ghost(&s, u_p, sliding, acceleration, normal[i], g);
+            out.p = material.pressure.apply(out.p);
+            let shown = material.present(m[i], u_p, out);
+            (*rho, *div, *visc, *av) = (shown.rho, shown.div, shown.visc, shown.av);
+        });
     }
 }
 

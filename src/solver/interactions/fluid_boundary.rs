@@ -108,19 +108,19 @@ impl RateTerms {
 }
 
 impl AccelTerms {
-    /// Adds boundary neighbour `b`'s share of particle `a`'s sums under plan `P`: `b` as the
-    /// divergence terms see it, `b_visc` as the viscous ones do; the homogenisation sees the
-    /// boundary as a neighbour, so that particles are not drawn into it.
+    /// Adds boundary neighbour `b`'s share of particle `a`'s sums under plan `P`, with the
+    /// views `[b, b_visc, b_av]` of the divergence terms, the viscosity and the artificial
+    /// viscosity; the homogenisation sees the boundary as a neighbour (`b`), so that
+    /// particles are not drawn into it.
     #[inline(always)]
     pub fn boundary_neighbour<const P: u32, const D: usize>(
         &self,
         s: &mut AccelSums<D>,
         a: &Point<D>,
         ab: &Pair<D>,
-        b: &Point<D>,
-        b_visc: &Point<D>,
+        [b, b_visc, b_av]: [&Point<D>; 3],
     ) {
-        self.pressure_and_viscous::<P, D>(s, a, ab, b, b_visc);
+        self.pressure_and_viscous::<P, D>(s, a, ab, [b, b_visc, b_av]);
         if self.has::<P>(plan::TRANSPORT) {
             self.homogenisation::<P, D>(s, a, ab, b);
         }

@@ -187,7 +187,7 @@ impl AccelTerms {
         ab: &Pair<D>,
         b: &Point<D>,
     ) {
-        self.pressure_and_viscous::<P, D>(s, a, ab, b, b);
+        self.pressure_and_viscous::<P, D>(s, a, ab, [b, b, b]);
         if self.has::<P>(plan::TRANSPORT) {
             s.acc += momentum::artificial_stress(a, b, ab);
             if self.has::<P>(plan::MOMENTUM_CORR) {
@@ -199,15 +199,15 @@ impl AccelTerms {
 
     /// The pressure gradient (eq. 27 or Adami's, with the BQL reference's weights and the
     /// neighbours' pressures if declared) with neighbour `b` as the divergence terms see
-    /// it, and the viscous terms with `b_visc` as they see it (they differ for a boundary).
+    /// it, the viscosity with `b_visc` and the artificial viscosity with `b_av` as they see it
+    /// (the three differ for a boundary).
     #[inline(always)]
     pub fn pressure_and_viscous<const P: u32, const D: usize>(
         &self,
         s: &mut AccelSums<D>,
         a: &Point<D>,
         ab: &Pair<D>,
-        b: &Point<D>,
-        b_visc: &Point<D>,
+        [b, b_visc, b_av]: [&Point<D>; 3],
     ) {
         if self.has::<P>(plan::ADAMI) {
             s.acc += momentum::pressure_gradient_adami(a, b, ab);
@@ -229,7 +229,7 @@ impl AccelTerms {
             s.acc += viscosity::morris(a, b_visc, ab, self.nu);
         }
         if self.has::<P>(plan::ARTIFICIAL_VISCOSITY) {
-            s.acc += artificial_viscosity::monaghan(a, b_visc, ab, self.av.0, self.av.1);
+            s.acc += artificial_viscosity::monaghan(a, b_av, ab, self.av.0, self.av.1);
         }
     }
 

@@ -29,8 +29,8 @@ impl<const P: u32, const D: usize> Gatherer<D> for AccelGather<'_, P, D> {
     }
 
     #[inline(always)]
-    fn boundary(&mut self, ab: &Pair<D>, b: &Point<D>, b_visc: &Point<D>) {
-        self.terms.boundary_neighbour::<P, D>(&mut self.sums, self.a, ab, b, b_visc);
+    fn boundary(&mut self, ab: &Pair<D>, views: [&Point<D>; 3]) {
+        self.terms.boundary_neighbour::<P, D>(&mut self.sums, self.a, ab, views);
     }
 }
 

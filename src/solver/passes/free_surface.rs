@@ -7,7 +7,7 @@ use crate::solver::equations::Point;
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::lists::KernelList;
 use crate::solver::math::Vector;
-use crate::solver::scheme::SurfacePressure;
+use crate::solver::scheme::{SurfaceCone, SurfacePressure};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 
@@ -38,14 +38,15 @@ fn volume_point<const D: usize>(m: f64, rho: f64) -> Point<D> {
 impl<const D: usize> SurfaceFields<D> {
     /// Detects the surface of the body `particles` (its list `nl`, its `boundaries` as
     /// neighbours) whose reference density is `rho0`: eq. (42) with its cut-off, eq. (43),
-    /// the low-density rule (summation density below rho0 / 2), the 60-degree test, and the
-    /// neighbours of surface particles.
+    /// the low-density rule (summation density below rho0 / 2), the 60-degree test over the
+    /// neighbours `cone` names, and the neighbours of surface particles.
     pub fn detect(
         &mut self,
         particles: Particles<'_, D>,
         nl: &KernelList<D>,
         boundaries: Boundaries<'_, D>,
         rho0: f64,
+        cone: SurfaceCone,
     ) {
         let Particles { x, m, rho, h } = particles;
         let n = particles.len();
@@ -95,11 +96,21 @@ impl<const D: usize> SurfaceFields<D> {
                 return;
             }
             let mut covered = false;
-            nl.for_each(i, x, |_, xij, r2, kw| covered |= in_normal_cone(&na, &kw.pair(xij, r2, h)));
-            for b in boundaries.iter() {
-                b.list.for_each_from(i, x[i], b.x, |_, xij, r2, kw| {
-                    covered |= in_normal_cone(&na, &kw.pair(xij, r2, h))
-                });
+            match cone {
+                SurfaceCone::Support => {
+                    nl.for_each(i, x, |_, xij, r2, kw| covered |= in_normal_cone(&na, &kw.pair(xij, r2, h)));
+                    for b in boundaries.iter() {
+                        b.list.for_each_from(i, x[i], b.x, |_, xij, r2, kw| {
+                            covered |= in_normal_cone(&na, &kw.pair(xij, r2, h))
+                        });
+                    }
+                }
+                SurfaceCone::Fluid2h => {
+                    let reach2 = 4.0 * h * h;
+                    nl.for_each(i, x, |_, xij, r2, kw| {
+                        covered |= r2 < reach2 && in_normal_cone(&na, &kw.pair(xij, r2, h))
+                    });
+                }
             }
             *out = !covered;
         });
@@ -152,5 +163,36 @@ mod tests {
         assert_eq!(apply(SurfacePressure::Zero), [0.0, -2.0, 0.0, 0.0]);
         assert_eq!(apply(SurfacePressure::ZeroIsolated), [-3.0, -2.0, 5.0, 0.0]);
         assert_eq!(apply(SurfacePressure::NonNegative), [0.0, -2.0, 5.0, 0.0]);
+    }
+
+    /// The 60-degree test of a particle on the top row of a block of fluid, with one more
+    /// particle straight above it 2.5 h away: within the support it covers the particle,
+    /// which is then not on the surface; the authors' test looks within 2h only, and finds
+    /// the particle on the surface.
+    #[test]
+    fn the_cone_reaches_as_far_as_it_is_told() {
+        use crate::solver::interactions::lists::build_kernel_list;
+        use crate::solver::kernel::{Kernel, KernelKind};
+        use crate::solver::nnps::{CellList, Domain};
+        let (n, dx) = (12usize, 0.1);
+        let mut x: Vec<Vector<2>> =
+            (0..n * n).map(|k| Vector::<2>::new((k % n) as f64 * dx, (k / n) as f64 * dx)).collect();
+        let top = n * n - n / 2; // a particle in the middle of the top row
+        x.push(x[top] + Vector::<2>::new(0.0, 2.5 * dx));
+        let (m, rho) = (vec![1.0 * dx * dx; x.len()], vec![1.0; x.len()]);
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let mut cells = CellList::new(Domain::bounded([-1.0; 2], [3.0; 2]), kernel.support() * dx);
+        cells.update(&x);
+        let mut nl = crate::solver::interactions::lists::KernelList::new();
+        build_kernel_list(&mut nl, &cells, &x, dx, &kernel);
+        let particles = Particles { x: &x, m: &m, rho: &rho, h: dx };
+        let on_surface = |cone| {
+            let mut fs = SurfaceFields::<2>::default();
+            fs.detect(particles, &nl, Boundaries::none(), 1.0, cone);
+            assert!(fs.normal[top][1] > 0.9, "the top row's normal points up: {:?}", fs.normal[top]);
+            fs.surface[top]
+        };
+        assert!(!on_surface(SurfaceCone::Support), "covered by the particle 2.5 h above");
+        assert!(on_surface(SurfaceCone::Fluid2h), "nothing within 2h above");
     }
 }

@@ -23,7 +23,7 @@ use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Gather, HalfPairs, PairSlices, Slabs};
 use crate::solver::schedule::stages::{run_stages, Board, Grid, Tiled};
-use crate::solver::scheme::Shifting;
+use crate::solver::scheme::{IpstTest, Shifting};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -96,7 +96,7 @@ impl<const D: usize> Ipst<D> {
         step: u64,
     ) -> usize {
         let w = self;
-        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref }) = shifting else {
+        let Some(Shifting::Ipst { u_max, tol, max_iter, interval, chi_ref, test }) = shifting else {
             return 0;
         };
         if !step.is_multiple_of(interval as u64) {
@@ -128,7 +128,7 @@ impl<const D: usize> Ipst<D> {
             nl.half_pairs(slabs.range(t), &mut slab.half);
         });
         let walls = BoundaryVolumes { boundaries, vol: &w.boundary_vol };
-        let test = Convergence { chi_ref, tol };
+        let test = Convergence { chi_ref, tol, one_sided: test == IpstTest::OneSided };
         let mut board = std::mem::take(&mut w.board);
         let witness = w.witness.get_mut().unwrap_or_else(PoisonError::into_inner);
         (witness.failed, witness.found) = (None, None);
@@ -324,16 +324,22 @@ struct SweepTask {
     slab: usize,
 }
 
-/// The test of eq. (39) on the largest chi of a sweep.
+/// The test of eq. (39) on the largest chi of a sweep ([`IpstTest`]).
 #[derive(Clone, Copy, Debug, Default)]
 struct Convergence {
     chi_ref: f64,
     tol: f64,
+    one_sided: bool,
 }
 
 impl Convergence {
     fn met(&self, chi_max: f64) -> bool {
-        (chi_max - self.chi_ref).abs() <= self.tol * self.chi_ref
+        let excess = chi_max - self.chi_ref;
+        if self.one_sided {
+            excess <= self.tol * self.chi_ref
+        } else {
+            excess.abs() <= self.tol * self.chi_ref
+        }
     }
 
     /// Whether `chi`, the chi of some particle, fails the test for the largest chi too:
@@ -627,6 +633,16 @@ mod tests {
     /// after `max_iter` sweeps; for 1-9 slabs on 1-3 workers taking turns (one starting
     /// late), with chi meeting the test at sweep 0, 3 or never.
     #[test]
+    fn the_one_sided_test_fails_on_an_excess_only() {
+        let two = Convergence { chi_ref: 1.0, tol: 0.02, one_sided: false };
+        let one = Convergence { one_sided: true, ..two };
+        for (chi_max, two_sided, one_sided) in [(1.01, true, true), (1.03, false, false), (0.9, false, true)]
+        {
+            assert_eq!((two.met(chi_max), one.met(chi_max)), (two_sided, one_sided), "max chi {chi_max}");
+        }
+    }
+
+    #[test]
     fn the_sweep_board_runs_each_stage_once_after_its_inputs() {
         let max_iter = 6;
         for slabs in 1..10 {
@@ -637,7 +653,12 @@ mod tests {
                             format!("{slabs} slabs, {workers} workers, met at {meets_at:?}, late {late}");
                         let bounds: Vec<usize> = (0..=slabs).map(|k| k * 100).collect();
                         let mut b = SweepBoard::default();
-                        b.reset(&bounds, workers, max_iter, Convergence { chi_ref: 1.0, tol: 0.1 });
+                        b.reset(
+                            &bounds,
+                            workers,
+                            max_iter,
+                            Convergence { chi_ref: 1.0, tol: 0.1, one_sided: false },
+                        );
                         let mut ran = vec![vec![0u32; slabs]; 2 * max_iter];
                         // chi 1.0 meets the test, 2.0 does not.
                         let chi = |t: &SweepTask| if Some(t.sweep) == meets_at { 1.0 } else { 2.0 };

@@ -64,12 +64,13 @@ impl<'a, const D: usize> Particles<'a, D> {
 }
 
 /// What a fluid particle does with each neighbour of a gather: a fluid neighbour `b`, or a
-/// boundary neighbour as the divergence terms (`b`) and the viscous terms (`b_visc`) see it.
+/// boundary neighbour as the divergence terms, the viscous terms and the artificial
+/// viscosity see it (`[b, b_visc, b_av]`).
 pub(crate) trait Gatherer<const D: usize> {
     /// A fluid neighbour.
     fn fluid(&mut self, ab: &Pair<D>, b: &Point<D>);
     /// A boundary neighbour.
-    fn boundary(&mut self, ab: &Pair<D>, b: &Point<D>, b_visc: &Point<D>);
+    fn boundary(&mut self, ab: &Pair<D>, views: [&Point<D>; 3]);
 }
 
 /// The sources a fluid particle sums over: its own body, then each boundary.
@@ -108,13 +109,13 @@ impl<'a, const D: usize> Sources<'a, D> {
             |_, xij, r2, kw, b| g.fluid(&kw.pair(xij, r2, h), b),
         );
         for b in self.boundaries.iter() {
-            let (div, visc) = (&b.model.div, &b.model.visc);
+            let (div, visc, av) = (&b.model.div, &b.model.visc, &b.model.av);
             b.list.for_each_from(
                 i,
                 xi,
                 b.x,
                 #[inline(always)]
-                |j, xij, r2, kw| g.boundary(&kw.pair(xij, r2, h), &div[j], &visc[j]),
+                |j, xij, r2, kw| g.boundary(&kw.pair(xij, r2, h), [&div[j], &visc[j], &av[j]]),
             );
         }
     }

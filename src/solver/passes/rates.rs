@@ -28,7 +28,7 @@ impl<const P: u32, const D: usize> Gatherer<D> for RateSums<'_, P, D> {
     }
 
     #[inline(always)]
-    fn boundary(&mut self, ab: &Pair<D>, b: &Point<D>, _: &Point<D>) {
+    fn boundary(&mut self, ab: &Pair<D>, [b, _, _]: [&Point<D>; 3]) {
         self.terms.boundary_neighbour::<P, D>(&mut self.sums, self.a, b, ab);
     }
 }

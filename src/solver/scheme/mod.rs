@@ -132,6 +132,25 @@ named_choices!(SurfacePressure {
     NonNegative => "non_negative",
 });
 
+/// Which neighbours the 60-degree test of the free-surface detection (sec. 3.4) looks at: a
+/// neighbour in the cone around a particle's normal makes it an inner particle. The paper
+/// does not say how far the cone reaches; the authors' code looks at the fluid within 2h.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceCone {
+    /// Every neighbour in the kernel's support, the walls' too.
+    #[default]
+    Support,
+    /// The fluid's particles within 2h (the authors' code): a thin jet keeps its surface
+    /// particles where a wall or the far part of the support would have covered them.
+    Fluid2h,
+}
+
+named_choices!(SurfaceCone {
+    Support => "support",
+    Fluid2h => "fluid_2h",
+});
+
 /// A free surface: detected every step (sec. 3.4), the shifting kept tangential near it
 /// (sec. 3.5).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -140,6 +159,9 @@ pub struct FreeSurface {
     pub rho0: f64,
     /// What the surface particles' pressure does.
     pub pressure: SurfacePressure,
+    /// The neighbours of the 60-degree test.
+    #[serde(default)]
+    pub cone: SurfaceCone,
 }
 
 /// The CTVF correction terms, each a switch.
@@ -240,6 +262,9 @@ pub enum Shifting {
         interval: usize,
         /// chi_ref of eq. (39), from the initial configuration.
         chi_ref: f64,
+        /// Which deviation fails the test.
+        #[serde(default)]
+        test: IpstTest,
     },
 }
 
@@ -247,6 +272,25 @@ pub enum Shifting {
 fn one() -> usize {
     1
 }
+
+/// Which deviation of the largest chi (eq. 40) from its reference fails IPST's test (eq. 39).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum IpstTest {
+    /// Either way, `|max chi - chi_ref| <= tol chi_ref`, eq. (39) as printed.
+    #[default]
+    TwoSided,
+    /// Only an excess, `max chi - chi_ref <= tol chi_ref`: particles packed more densely
+    /// than at the start. With a free surface, where chi_ref is the initial maximum, a flow
+    /// that spreads (a splash, a thin layer) lowers the largest chi below it, which the
+    /// two-sided test reads as disorder and answers with every move a step.
+    OneSided,
+}
+
+named_choices!(IpstTest {
+    TwoSided => "two_sided",
+    OneSided => "one_sided",
+});
 
 /// The transport velocity a scheme declares.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -4,8 +4,8 @@
 //! the scheme asked for ([`SchemeOptions`]).
 
 use super::{
-    paper, Corrections, DensityModel, FluidScheme, FreeSurface, PressureGradient, PressureModel,
-    PressureReference, Pst, SchemeName, Shifting, SurfacePressure, Transport,
+    paper, Corrections, DensityModel, FluidScheme, FreeSurface, IpstTest, PressureGradient, PressureModel,
+    PressureReference, Pst, SchemeName, Shifting, SurfaceCone, SurfacePressure, Transport,
 };
 
 /// What a scene gives a scheme name to build a [`FluidScheme`] from.
@@ -46,6 +46,10 @@ pub struct FluidSettings {
     pub pressure_reference: PressureReference,
     /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
     pub free_surface: Option<SurfacePressure>,
+    /// The neighbours of the free surface's 60-degree test.
+    pub surface_cone: SurfaceCone,
+    /// Which deviation fails IPST's test.
+    pub ipst_test: IpstTest,
 }
 
 impl FluidSettings {
@@ -72,6 +76,8 @@ impl FluidSettings {
             gravity: [0.0; 3],
             pressure_reference: PressureReference::Auto,
             free_surface: None,
+            surface_cone: SurfaceCone::Support,
+            ipst_test: IpstTest::TwoSided,
         }
     }
 }
@@ -138,6 +144,7 @@ impl SchemeName {
                         max_iter: s.ipst_max_iter,
                         interval: s.ipst_interval,
                         chi_ref: f64::NAN, // measured on the initial configuration
+                        test: s.ipst_test,
                     }),
                     Pst::None => None,
                 };
@@ -145,7 +152,11 @@ impl SchemeName {
                     density: s.density,
                     pressure_gradient: PressureGradient::Symmetric { bql: false },
                     transport: shifting.map(|shifting| Transport { shifting, corrections: s.corrections }),
-                    free_surface: s.free_surface.map(|pressure| FreeSurface { rho0: s.rho0, pressure }),
+                    free_surface: s.free_surface.map(|pressure| FreeSurface {
+                        rho0: s.rho0,
+                        pressure,
+                        cone: s.surface_cone,
+                    }),
                     ..base
                 }
             }
@@ -187,6 +198,8 @@ pub struct SchemeOptions {
     pub ipst_max_iter: Option<usize>,
     /// IPST's interval (`ctvf` with `pst = ipst`).
     pub ipst_interval: Option<usize>,
+    /// IPST's test (`ctvf` with `pst = ipst`).
+    pub ipst_test: Option<IpstTest>,
     /// alpha of nu_edac, eq. (24) (the EDAC schemes: not `tvf`).
     pub edac_alpha: Option<f64>,
 }
@@ -217,6 +230,7 @@ impl SchemeOptions {
             ("ipst_tol", self.ipst_tol.is_some()),
             ("ipst_max_iter", self.ipst_max_iter.is_some()),
             ("ipst_interval", self.ipst_interval.is_some()),
+            ("ipst_test", self.ipst_test.is_some()),
         ];
         if let Some((key, _)) = ipst.iter().find(|(_, given)| *given && !(ctvf && pst == Pst::Ipst)) {
             let why = if ctvf {

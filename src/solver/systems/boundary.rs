@@ -61,6 +61,41 @@ named_choices!(WallPressure {
     NonNegative => "non_negative",
 });
 
+/// The velocity a boundary particle presents to the fluid's artificial viscosity (eqs.
+/// 28-29). The paper uses the no-slip ghost velocity of eq. (50) for "the viscous force" and
+/// does not say which its artificial viscosity takes; PySPH's walls and the authors' code
+/// present the wall's own velocity there. Against a wall at rest the ghost velocity is the
+/// fluid's mirrored, so the no-slip choice roughly doubles the damping of the normal
+/// approach and adds friction to an inviscid flow.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub enum WallViscosity {
+    /// The no-slip ghost velocity of eq. (50), as the viscous terms.
+    #[default]
+    NoSlip,
+    /// The wall's own velocity u_p (PySPH, the authors' code).
+    Wall,
+}
+
+named_choices!(WallViscosity {
+    NoSlip => "no_slip",
+    Wall => "wall",
+});
+
+/// What a boundary particle presents once its values are extrapolated: its density, and
+/// the views of it the divergence terms, the viscous terms and the artificial viscosity
+/// read.
+#[derive(Clone, Copy, Debug)]
+pub struct Presented<const D: usize> {
+    /// Density ([`WallDensity`]).
+    pub rho: f64,
+    /// With the slip velocities of eqs. (48)-(49).
+    pub div: Point<D>,
+    /// With the no-slip velocity of eq. (50).
+    pub visc: Point<D>,
+    /// With the velocity [`WallViscosity`] names.
+    pub av: Point<D>,
+}
+
 /// The constants of a boundary's density and pressure models.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BoundaryMaterial {
@@ -74,6 +109,9 @@ pub struct BoundaryMaterial {
     /// How the pressure follows the extrapolated one.
     #[serde(default)]
     pub pressure: WallPressure,
+    /// The velocity the fluid's artificial viscosity sees.
+    #[serde(default)]
+    pub viscosity: WallViscosity,
 }
 
 impl BoundaryMaterial {
@@ -86,17 +124,17 @@ impl BoundaryMaterial {
         }
     }
 
-    /// What a particle of mass `m` presents once its extrapolated values `g` are known
-    /// (with the pressure model applied): its density, and its views for the divergence and
-    /// the viscous terms.
+    /// What a particle of mass `m` and velocity `u_p` presents once its extrapolated values
+    /// `g` are known (with the pressure model applied).
     #[inline(always)]
-    pub fn present<const D: usize>(&self, m: f64, g: &Ghost<D>) -> (f64, Point<D>, Point<D>) {
+    pub fn present<const D: usize>(&self, m: f64, u_p: Vector<D>, g: &Ghost<D>) -> Presented<D> {
         let rho = self.density_at(g.p);
-        (
-            rho,
-            Point::new(g.u_slip, g.u_hat_slip, m, rho, g.p),
-            Point::new(g.u_noslip, g.u_noslip, m, rho, g.p),
-        )
+        let visc = Point::new(g.u_noslip, g.u_noslip, m, rho, g.p);
+        let av = match self.viscosity {
+            WallViscosity::NoSlip => visc,
+            WallViscosity::Wall => Point::new(u_p, u_p, m, rho, g.p),
+        };
+        Presented { rho, div: Point::new(g.u_slip, g.u_hat_slip, m, rho, g.p), visc, av }
     }
 }
 
@@ -122,6 +160,9 @@ pub struct BoundaryModel<const D: usize> {
     /// The particles as the fluid's viscous terms see them: the no-slip velocity of eq. (50).
     #[serde(skip)]
     pub visc: Vec<Point<D>>,
+    /// The particles as the fluid's artificial viscosity sees them ([`WallViscosity`]).
+    #[serde(skip)]
+    pub av: Vec<Point<D>>,
 }
 
 impl<const D: usize> BoundaryModel<D> {
@@ -131,8 +172,13 @@ impl<const D: usize> BoundaryModel<D> {
         if !(mass > 0.0 && rho0 > 0.0 && c0 > 0.0) {
             return Err(format!("mass {mass}, rho0 {rho0} and c0 {c0} must be positive"));
         }
-        let material =
-            BoundaryMaterial { rho0, c0, density: WallDensity::default(), pressure: WallPressure::default() };
+        let material = BoundaryMaterial {
+            rho0,
+            c0,
+            density: WallDensity::default(),
+            pressure: WallPressure::default(),
+            viscosity: WallViscosity::default(),
+        };
         let mut model = Self {
             m: vec![mass; n],
             material,
@@ -140,6 +186,7 @@ impl<const D: usize> BoundaryModel<D> {
             rho: Vec::new(),
             div: Vec::new(),
             visc: Vec::new(),
+            av: Vec::new(),
         };
         model.resize();
         Ok(model)
@@ -151,11 +198,12 @@ impl<const D: usize> BoundaryModel<D> {
         let n = self.m.len();
         let rest =
             Ghost { p: 0.0, u_slip: Vector::zeros(), u_hat_slip: Vector::zeros(), u_noslip: Vector::zeros() };
-        let (rho, div, _) = self.material.present(self.m.first().copied().unwrap_or(1.0), &rest);
+        let at_rest = self.material.present(self.m.first().copied().unwrap_or(1.0), Vector::zeros(), &rest);
         self.ghost.resize(n, rest);
-        self.rho.resize(n, rho);
-        self.div.resize(n, div);
-        self.visc.resize(n, div);
+        self.rho.resize(n, at_rest.rho);
+        self.div.resize(n, at_rest.div);
+        self.visc.resize(n, at_rest.visc);
+        self.av.resize(n, at_rest.av);
     }
 
     /// Number of particles.
@@ -184,6 +232,26 @@ mod tests {
         }
         assert_eq!(WallDensity::from_name("heavy"), None);
         assert!(BoundaryModel::<2>::new(1, 0.0, 1000.0, 20.0).unwrap_err().contains("mass 0"));
+    }
+
+    /// The artificial viscosity sees the no-slip ghost velocity or the wall's own; the other
+    /// views do not change with the choice.
+    #[test]
+    fn the_artificial_viscosity_sees_the_velocity_chosen() {
+        let g = Ghost {
+            p: 5.0,
+            u_slip: Vector::<2>::new(1.0, 0.0),
+            u_hat_slip: Vector::<2>::new(1.0, 0.1),
+            u_noslip: Vector::<2>::new(-1.0, 0.5),
+        };
+        let mut material = BoundaryModel::<2>::new(1, 1e-3, 1000.0, 20.0).unwrap().material;
+        let u_p = Vector::<2>::new(0.3, 0.0);
+        let no_slip = material.present(1e-3, u_p, &g);
+        assert_eq!(no_slip.av.u, g.u_noslip);
+        material.viscosity = WallViscosity::Wall;
+        let wall = material.present(1e-3, u_p, &g);
+        assert_eq!((wall.av.u, wall.av.du), (u_p, Vector::zeros()));
+        assert_eq!((wall.div.u, wall.visc.u, wall.rho), (no_slip.div.u, no_slip.visc.u, no_slip.rho));
     }
 
     #[test]

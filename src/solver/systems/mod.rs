@@ -16,7 +16,7 @@ pub mod boundary;
 pub mod fluid;
 pub mod wall;
 
-pub use boundary::{BoundaryMaterial, BoundaryModel, WallDensity, WallPressure};
+pub use boundary::{BoundaryMaterial, BoundaryModel, Presented, WallDensity, WallPressure, WallViscosity};
 pub use fluid::{Fluid, FluidInit, FluidPart, FluidRates};
 pub use wall::{Wall, WallMotion};
 

@@ -70,10 +70,15 @@ impl<const D: usize> Wall<D> {
         Ok(Self { name: name.into(), x, normal, motion: WallMotion::Sliding { u: u_wall }, boundary })
     }
 
-    /// The wall with its density and pressure models set.
-    pub fn with_models(mut self, density: super::WallDensity, pressure: super::WallPressure) -> Self {
-        self.boundary.material.density = density;
-        self.boundary.material.pressure = pressure;
+    /// The wall with its density, pressure and artificial-viscosity models set.
+    pub fn with_models(
+        mut self,
+        density: super::WallDensity,
+        pressure: super::WallPressure,
+        viscosity: super::WallViscosity,
+    ) -> Self {
+        let m = &mut self.boundary.material;
+        (m.density, m.pressure, m.viscosity) = (density, pressure, viscosity);
         self
     }
 
