@@ -16,7 +16,7 @@
 
 use super::common::{
     check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim,
-    scheme_params, shepard, shifting_columns, snapshot_bodies, time_settings, wall_density, wall_from,
+    scheme_params, shepard, shifting_columns, simulation, snapshot_bodies, wall_density, wall_from,
     wall_params, wall_pressure, wall_viscosity, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
@@ -122,13 +122,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     );
     let edge = (LAYERS as f64 + 0.5) * dx;
     let domain = Domain::bounded([-edge, -edge], [L + edge, L + edge]);
-    let time = time_settings(p);
-    let sim = Simulation::builder(domain, kernel)
-        .body(fluid)
-        .body(wall)
-        .time(time)
-        .build()
-        .map_err(|e| format!("scene `cavity`: {e}"))?;
+    let sim = simulation("cavity", p, domain, kernel, [fluid.into(), wall.into()])?;
     Ok(Box::new(Cavity {
         sim,
         re,

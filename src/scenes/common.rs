@@ -91,6 +91,23 @@ pub fn free_surface_params() -> Vec<Spec> {
     ]
 }
 
+/// The simulation of scene `scene`: `bodies` in `domain` with `kernel`, its time loop as
+/// the common parameters `p` set it ([`time_settings`]); an error names the scene.
+pub fn simulation<const D: usize>(
+    scene: &str,
+    p: &Params,
+    domain: crate::solver::nnps::Domain<D>,
+    kernel: Kernel,
+    bodies: impl IntoIterator<Item = Body<D>>,
+) -> Result<Simulation<D>, String> {
+    let builder = Simulation::builder(domain, kernel).time(time_settings(p));
+    bodies
+        .into_iter()
+        .fold(builder, |b, body| b.body(body))
+        .build()
+        .map_err(|e| format!("scene `{scene}`: {e}"))
+}
+
 /// The time loop's settings from the common parameters (`cfl`, `rate_positions`).
 pub fn time_settings(p: &Params) -> TimeSettings {
     TimeSettings {

@@ -17,8 +17,8 @@
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
-    surface_fields, time_settings, wall_params, FluidConstants,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, simulation,
+    snapshot_bodies, surface_fields, wall_params, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::tank::{Column, G, LAYERS};
@@ -132,13 +132,7 @@ fn dam_break(p: &Params) -> Result<DamBreak, String> {
     // 4 sqrt(g H) climbs to, and as far below, and a tank width on either side.
     let reach = th + 8.0 * hc;
     let domain = Domain::bounded([-tw, -reach], [2.0 * tw, reach]);
-    let time = time_settings(p);
-    let sim = Simulation::builder(domain, kernel)
-        .body(fluid)
-        .body(wall)
-        .time(time)
-        .build()
-        .map_err(|e| format!("scene `dam_break`: {e}"))?;
+    let sim = simulation("dam_break", p, domain, kernel, [fluid.into(), wall.into()])?;
     Ok(DamBreak { sim, dx, column_width: l, tank_width: tw, toe: Vec::new() })
 }
 

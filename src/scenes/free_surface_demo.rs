@@ -8,7 +8,7 @@
 
 use super::common::{
     check_size, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim,
-    scheme_params, snapshot_bodies, surface_fields, time_settings, wall_from, FluidConstants,
+    scheme_params, simulation, snapshot_bodies, surface_fields, wall_from, FluidConstants,
 };
 use super::geometry::{box_walls, lattice};
 use super::params::{Bound, Params, Spec};
@@ -108,13 +108,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     let wall =
         (!walls.is_empty()).then(|| wall_from(&walls, |_| Vector::zeros(), dx, RHO0, 10.0)).transpose()?;
     let domain = Domain::bounded([-2.0, -2.0], [5.0, 4.0]);
-    let time = time_settings(p);
-    let sim = wall
-        .into_iter()
-        .fold(Simulation::builder(domain, kernel).body(fluid), |b, w| b.body(w))
-        .time(time)
-        .build()
-        .map_err(|e| format!("scene `free_surface_demo`: {e}"))?;
+    let bodies = std::iter::once(fluid.into()).chain(wall.map(Into::into));
+    let sim = simulation("free_surface_demo", p, domain, kernel, bodies)?;
     Ok(Box::new(Demo { sim, outer }))
 }
 

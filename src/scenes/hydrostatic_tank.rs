@@ -13,8 +13,8 @@
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
 use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, snapshot_bodies,
-    time_settings, wall_params, FluidConstants,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, simulation,
+    snapshot_bodies, wall_params, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::tank::{Column, G, LAYERS, RHO0};
@@ -106,13 +106,7 @@ fn tank(p: &Params) -> Result<Tank, String> {
     let rise = 0.5 * a * p.float("tf").powi(2);
     let domain =
         Domain::bounded([-edge, -edge + rise.min(0.0)], [width + edge, tank_height + edge + rise.max(0.0)]);
-    let time = time_settings(p);
-    let sim = Simulation::builder(domain, kernel)
-        .body(fluid)
-        .body(wall)
-        .time(time)
-        .build()
-        .map_err(|e| format!("scene `hydrostatic_tank`: {e}"))?;
+    let sim = simulation("hydrostatic_tank", p, domain, kernel, [fluid.into(), wall.into()])?;
     Ok(Tank { sim, height, width, a })
 }
 

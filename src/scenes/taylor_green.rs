@@ -21,7 +21,7 @@
 
 use super::common::{
     check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, shifting_columns,
-    snapshot_bodies, time_settings, FluidConstants,
+    snapshot_bodies, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::{common_params, SceneEntry, SceneRun};
@@ -252,12 +252,7 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
         }
     }
     let fluid = Fluid::new("fluid", h, init, scheme)?;
-    let time = time_settings(p);
-    Simulation::builder(domain, kernel)
-        .body(fluid)
-        .time(time)
-        .build()
-        .map_err(|e| format!("scene `{}`: {e}", name::<D>()))
+    super::common::simulation(name::<D>(), p, domain, kernel, [fluid.into()])
 }
 
 /// Parameters of this scene from `key=value` strings over the defaults.
