@@ -76,11 +76,6 @@ impl<'a, const D: usize> Boundaries<'a, D> {
         Self { couplings: &[], bodies: &[] }
     }
 
-    /// Whether there is none.
-    pub fn is_empty(&self) -> bool {
-        self.couplings.is_empty()
-    }
-
     /// Each boundary, in order.
     #[inline(always)]
     pub fn iter(&self) -> impl Iterator<Item = BoundarySource<'a, D>> + 'a {

@@ -106,14 +106,6 @@ impl<const D: usize> Body<D> {
         }
     }
 
-    /// The wall, if this is one, mutably.
-    pub fn as_wall_mut(&mut self) -> Option<&mut Wall<D>> {
-        match self {
-            Body::Wall(w) => Some(w),
-            _ => None,
-        }
-    }
-
     /// The body as a boundary a fluid reads: its positions and what they present (a
     /// wall's extrapolated values); `None` for a body that is not one.
     pub fn as_boundary(&self) -> Option<(&[Vector<D>], &BoundaryModel<D>)> {
