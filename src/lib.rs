@@ -14,5 +14,6 @@
 
 pub mod automation;
 pub mod bench;
+pub mod console;
 pub mod scenes;
 pub mod solver;

@@ -6,6 +6,7 @@ use sphrepro::automation::runner;
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
 use sphrepro::solver::simulation::TUNING_STEPS;
+use sphrepro::{err, errln, outln};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -261,7 +262,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
-            eprintln!("error: cannot start {n} threads: {e}");
+            errln!("error: cannot start {n} threads: {e}");
             return ExitCode::from(2);
         }
     }
@@ -270,7 +271,15 @@ fn main() -> ExitCode {
     // from inside it, without handing each one over from a thread outside the pool, which
     // costs a sleep and a wake-up per loop (measured: 15 % more particle-steps per second on
     // one thread at 2 500 particles).
-    rayon::scope(|_| run(cli))
+    let code = rayon::scope(|_| run(cli));
+    // Output that could not be written is an error, whatever the command did otherwise.
+    match sphrepro::console::failure() {
+        Some(e) => {
+            errln!("error: {e}");
+            ExitCode::from(if code == 0 { 1 } else { code })
+        }
+        None => ExitCode::from(code),
+    }
 }
 
 /// Ctrl-C, SIGTERM and SIGHUP stop a run with a checkpoint (a second one exits at once).
@@ -303,34 +312,33 @@ fn install_signal_handlers() {
     }
 }
 
-fn run(cli: Cli) -> ExitCode {
+/// Runs the command; returns its exit status.
+fn run(cli: Cli) -> u8 {
     match cli.command {
         Command::List { preset, dirs } => {
             let code = commands::list(&dirs.dirs(), &preset);
             if code != 0 {
-                return ExitCode::from(code);
+                return code;
             }
             print_scenes();
-            ExitCode::SUCCESS
+            0
         }
-        Command::Run { problem, args } => ExitCode::from(commands::run(
+        Command::Run { problem, args } => commands::run(
             &args.dirs.dirs(),
             &args.preset,
             &problem,
             &args.options(),
             &RunFlags { plot_only: args.plot_only, manuscript: false },
-        )),
-        Command::Reproduce { args } => ExitCode::from(commands::run(
+        ),
+        Command::Reproduce { args } => commands::run(
             &args.dirs.dirs(),
             &args.preset,
             &[],
             &args.options(),
             &RunFlags { plot_only: args.plot_only, manuscript: true },
-        )),
-        Command::Status { preset, stale, dirs } => {
-            ExitCode::from(commands::status(&dirs.dirs(), &preset, stale))
-        }
-        Command::Check { preset, dirs } => ExitCode::from(commands::check(&dirs.dirs(), &preset)),
+        ),
+        Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(), &preset, stale),
+        Command::Check { preset, dirs } => commands::check(&dirs.dirs(), &preset),
         Command::Simulate {
             scene,
             sets,
@@ -358,54 +366,56 @@ fn run(cli: Cli) -> ExitCode {
 
 /// `simulate`: one run of `scene` into `out`; exit 0 when it completes, 3 when it diverges
 /// (a result, reported as such), 2 on bad input and 1 when the run fails.
-fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::RunOptions) -> ExitCode {
+fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::RunOptions) -> u8 {
     let (entry, params) = match scenes::find(scene).and_then(|e| Ok((e, e.params_from_sets(sets)?))) {
         Ok(found) => found,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
         }
     };
     match harness::run(entry, &params, out, &opts) {
         Ok(s) => match s.status {
             sphrepro::solver::output::summary::Status::Completed => {
                 if !opts.quiet {
-                    eprintln!(
+                    errln!(
                         "completed: {} steps, {:.2} s, {:.3e} particle-steps/s",
-                        s.steps, s.wall_seconds, s.particle_steps_per_second
+                        s.steps,
+                        s.wall_seconds,
+                        s.particle_steps_per_second
                     );
                     for (k, v) in &s.metrics {
-                        eprintln!("  {k} = {v:.6e}");
+                        errln!("  {k} = {v:.6e}");
                     }
                 }
-                ExitCode::SUCCESS
+                0
             }
             _ => {
-                eprintln!(
+                errln!(
                     "diverged at step {} (t = {}): {}",
                     s.step.unwrap_or(s.steps),
                     s.final_time,
                     s.reason.as_deref().unwrap_or("")
                 );
-                ExitCode::from(3)
+                3
             }
         },
         Err(harness::RunError::Input(e)) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
+            errln!("error: {e}");
+            2
         }
         Err(harness::RunError::Failed(e)) => {
-            eprintln!("failed: {e}");
-            ExitCode::from(1)
+            errln!("failed: {e}");
+            1
         }
     }
 }
 
 /// The scenes, each with its parameters (name, kind, default, help) and metrics.
 fn print_scenes() {
-    println!("scenes:");
+    outln!("scenes:");
     for s in scenes::SCENES {
-        println!("{} ({}D): {}", s.name, s.dim, s.about);
+        outln!("{} ({}D): {}", s.name, s.dim, s.about);
         let params = (s.params)();
         // Columns as wide as the scene's widest entry, so that long names and
         // choice lists keep the help text aligned.
@@ -416,9 +426,9 @@ fn print_scenes() {
         let width = |c: usize| rows.iter().map(|r| r[c].len()).max().unwrap_or(0);
         let (w0, w1, w2) = (width(0), width(1), width(2));
         for [name, kind, default, help] in &rows {
-            println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
+            outln!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
         }
-        println!("    metrics: {}", s.metrics.join(", "));
+        outln!("    metrics: {}", s.metrics.join(", "));
     }
 }
 
@@ -459,15 +469,15 @@ fn edac_l1(exe: &std::path::Path, nx: usize, threads: usize, tf: f64, kernel: &s
 const BENCH_WARMUP: u64 = TUNING_STEPS as u64 + 2;
 
 /// A bench child's result as one JSON line on stdout, or its error on stderr (exit 1).
-fn print_json(r: Result<impl serde::Serialize, String>) -> ExitCode {
+fn print_json(r: Result<impl serde::Serialize, String>) -> u8 {
     match r {
         Ok(r) => {
-            println!("{}", serde_json::to_string(&r).expect("serialises"));
-            ExitCode::SUCCESS
+            outln!("{}", serde_json::to_string(&r).expect("serialises"));
+            0
         }
         Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::from(1)
+            errln!("error: {e}");
+            1
         }
     }
 }
@@ -566,17 +576,17 @@ fn peer_run(
     bench::parse_peer(&String::from_utf8_lossy(&o.stdout), nx, threads, tf)
 }
 
-fn run_bench(args: BenchArgs) -> ExitCode {
+fn run_bench(args: BenchArgs) -> u8 {
     let BenchArgs { nx, bench_threads: threads, variants, steps, repeat, json, peer, kernel, interleave } =
         args;
     let started = chrono::Utc::now();
     let kernel = kernel.as_str();
     if !sphrepro::solver::kernel::KernelKind::NAMES.contains(&kernel) {
-        eprintln!(
+        errln!(
             "error: bench: --kernel {kernel}: expected one of {}",
             sphrepro::solver::kernel::KernelKind::NAMES.join(", ")
         );
-        return ExitCode::from(2);
+        return 2;
     }
     let variants: Vec<String> =
         variants.unwrap_or_else(|| bench::VARIANTS.iter().map(|v| v.0.to_string()).collect());
@@ -584,16 +594,16 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     if let Some(v) = variants.iter().find(|v| !bench::known_variant(v)) {
         let known: Vec<&str> = bench::VARIANTS.iter().map(|k| k.0).collect();
         let suffixes: Vec<&str> = bench::SCHEDULES.iter().map(|s| s.0).collect();
-        eprintln!(
+        errln!(
             "error: bench: --variants {v}: expected one of {}, each optionally ending in {}",
             known.join(", "),
             suffixes.join(" or ")
         );
-        return ExitCode::from(2);
+        return 2;
     }
     if let Some(script) = peer.as_ref().filter(|p| !p.is_file()) {
-        eprintln!("error: bench: --peer {}: no such file", script.display());
-        return ExitCode::from(2);
+        errln!("error: bench: --peer {}: no such file", script.display());
+        return 2;
     }
     let exe = std::env::current_exe().expect("own executable");
     let (mut results, mut peers) = (Vec::new(), Vec::new());
@@ -603,7 +613,7 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     if let Some(rounds) = interleave {
         for &n in &nx {
             let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-            eprint!(
+            err!(
                 "bench nx={n}, {} on {threads:?} threads side by side, {rounds} rounds of {} steps each ... ",
                 variants.join(", "),
                 k.div_ceil(rounds as u64)
@@ -621,11 +631,11 @@ fn run_bench(args: BenchArgs) -> ExitCode {
                             )
                         })
                         .collect();
-                    eprintln!("{}", speeds.join(", "));
+                    errln!("{}", speeds.join(", "));
                     results.extend(r);
                 }
                 Err(e) => {
-                    eprintln!("{e}");
+                    errln!("{e}");
                     failure = Some(format!("bench nx={n}, side by side: {e}"));
                     break;
                 }
@@ -640,14 +650,14 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             for v in &variants {
                 for &t in &threads {
                     let k = steps.unwrap_or_else(|| bench::default_steps(n * n));
-                    eprint!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
+                    err!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
                     match bench_case(&exe, v, n, t, k, kernel) {
                         Ok(r) => {
-                            eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
+                            errln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
                             results.push(r);
                         }
                         Err(e) => {
-                            eprintln!("{e}");
+                            errln!("{e}");
                             failure = Some(format!("bench {v} nx={n} threads={t}: {e}"));
                             break 'rounds;
                         }
@@ -660,14 +670,14 @@ fn run_bench(args: BenchArgs) -> ExitCode {
             for &n in &nx {
                 for &t in &threads {
                     let tf = bench::peer_tf(n);
-                    eprint!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
+                    err!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
                     match peer_run(script, n, t, tf) {
                         Ok(p) => {
-                            eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                            errln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
                             peers.push(p);
                         }
                         Err(e) => {
-                            eprintln!("error: peer {}: {e}", script.display());
+                            errln!("error: peer {}: {e}", script.display());
                             failure = Some(format!("peer {} nx={n} threads={t}: {e}", script.display()));
                             break 'rounds;
                         }
@@ -681,15 +691,15 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     let mut peers = bench::median_runs(peers);
     for p in &mut peers {
         let (n, t) = (p.nx, p.threads);
-        eprint!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
+        err!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
         match edac_l1(&exe, n, t, p.end_time(), kernel) {
             Ok(l1) => {
                 p.sphrepro_l1_velocity_final = Some(l1);
                 let peer = p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
-                eprintln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
+                errln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
             }
             Err(e) => {
-                eprintln!("\nerror: edac on the peer's run: {e}");
+                errln!("\nerror: edac on the peer's run: {e}");
                 failure.get_or_insert(format!("edac on the peer's run nx={n} threads={t}: {e}"));
             }
         }
@@ -697,8 +707,8 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     // The host and build: figures compare only within one kind of host, and without a
     // vector path for the distance test the neighbour list costs a host more.
     let provenance = sphrepro::solver::output::summary::Provenance::now(started);
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", provenance.machine.describe());
-    println!("{}", bench::table(&results, &peers));
+    outln!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", provenance.machine.describe());
+    outln!("{}", bench::table(&results, &peers));
     let targets = bench::targets::targets(&results, &peers);
     if !targets.is_empty() {
         // The issue's figures are PySPH's own run, with its quintic spline.
@@ -707,15 +717,15 @@ fn run_bench(args: BenchArgs) -> ExitCode {
         } else {
             format!(" (they are set for the {} kernel; this sitting ran {kernel})", bench::DEFAULT_KERNEL)
         };
-        println!(
+        outln!(
             "Against the targets of issue 3, in this sitting{caveat}:\n\n{}",
             bench::targets::table(&targets)
         );
     }
     if let Some(dir) = json.parent().filter(|d| !d.as_os_str().is_empty()) {
         if let Err(e) = std::fs::create_dir_all(dir) {
-            eprintln!("error: {}: {e}", dir.display());
-            return ExitCode::from(1);
+            errln!("error: {}: {e}", dir.display());
+            return 1;
         }
     }
     let text = serde_json::to_string_pretty(
@@ -723,15 +733,15 @@ fn run_bench(args: BenchArgs) -> ExitCode {
     )
     .expect("serialises");
     if let Err(e) = sphrepro::solver::output::write_atomic(&json, text.as_bytes()) {
-        eprintln!("error: {}: {e}", json.display());
-        return ExitCode::from(1);
+        errln!("error: {}: {e}", json.display());
+        return 1;
     }
-    eprintln!("wrote {}", json.display());
+    errln!("wrote {}", json.display());
     match failure {
         Some(e) => {
-            eprintln!("error: the sitting stopped early (the table and the JSON hold what ran before): {e}");
-            ExitCode::from(1)
+            errln!("error: the sitting stopped early (the table and the JSON hold what ran before): {e}");
+            1
         }
-        None => ExitCode::SUCCESS,
+        None => 0,
     }
 }

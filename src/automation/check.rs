@@ -3,6 +3,7 @@
 
 use super::cache::{self, State};
 use super::registry::Problem;
+use crate::outln;
 use crate::solver::output::summary::Status;
 use std::path::Path;
 
@@ -129,7 +130,7 @@ fn progress(dir: &Path) -> Option<(f64, f64)> {
 pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCounts {
     let mut n = StatusCounts::default();
     for p in problems {
-        println!("{} ({}, preset {}):", p.name, p.title, p.preset);
+        outln!("{} ({}, preset {}):", p.name, p.title, p.preset);
         let entries = cache::entries(output, p);
         for e in &entries {
             let st = e.state();
@@ -139,7 +140,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                 State::Missing(_) => n.missing += 1,
             }
             let running = super::lock::Lock::holder(&e.dir).is_some();
-            println!(
+            outln!(
                 "  {:<10} {}{}",
                 match st {
                     State::Done(_) => "done",
@@ -175,12 +176,12 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
         }
         let live: Vec<_> = current.iter().map(|e| e.dir.clone()).collect();
         if other_presets > 0 {
-            println!("  {other_presets} folder(s) with the results of the problem's other preset(s)");
+            outln!("  {other_presets} folder(s) with the results of the problem's other preset(s)");
         }
         let stale = cache::stale_folders(output, &p.name, &live);
         n.stale_folders += stale.len();
         if !list_stale && !stale.is_empty() {
-            println!(
+            outln!(
                 "  {} stale folder(s): results of earlier inputs, kept, not deleted (`status --stale` lists them)",
                 stale.len()
             );
@@ -200,12 +201,15 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                     }
                 })
                 .unwrap_or_else(|| "no case.json".into());
-            println!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
+            outln!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
         }
     }
-    println!(
+    outln!(
         "{} done, {} failed, {} missing, {} stale folder(s)",
-        n.done, n.failed, n.missing, n.stale_folders
+        n.done,
+        n.failed,
+        n.missing,
+        n.stale_folders
     );
     n
 }

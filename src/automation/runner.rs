@@ -7,6 +7,7 @@
 use super::cache::{Entry, State};
 use super::lock::{Lock, Try};
 use super::registry::Problem;
+use crate::outln;
 use crate::scenes::harness::INTERRUPTED;
 use crate::scenes::progress::{duration, read_file};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -105,7 +106,7 @@ pub fn split_cores(jobs: Option<usize>, tasks: usize, threads: usize) -> (usize,
 
 /// Prints a line above the progress bars.
 fn say(mp: &MultiProgress, line: String) {
-    mp.suspend(|| println!("{line}"));
+    mp.suspend(|| outln!("{line}"));
 }
 
 /// Runs `tasks` in a job pool. Failures are collected, not fatal; Ctrl-C stops starting

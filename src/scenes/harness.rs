@@ -3,6 +3,7 @@
 use super::progress::Progress;
 use super::{params::Params, SceneEntry, SceneRun};
 
+use crate::errln;
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
 use std::collections::BTreeMap;
@@ -117,7 +118,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     };
     let plan = scene.plan();
     if !opts.quiet {
-        eprintln!("{} with {} particles\n{plan}", entry.name, scene.particles());
+        errln!("{} with {} particles\n{plan}", entry.name, scene.particles());
     }
     let _ = std::fs::write(out.join("plan.txt"), &plan);
 
@@ -144,7 +145,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 series.insert(body, Series::with_entries(pvd, entries));
             }
             if !opts.quiet {
-                eprintln!("resuming from {} at t = {}", ckpt_path.display(), scene.time());
+                errln!("resuming from {} at t = {}", ckpt_path.display(), scene.time());
             }
         }
         None => {
@@ -212,7 +213,9 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let ts0 = Instant::now();
         let res = scene.advance(target, tf, &mut |time, steps| {
             progress.update(time, steps, &rate);
-            !INTERRUPTED.load(Ordering::Relaxed) && opts.stop_after_steps.is_none_or(|n| steps < n)
+            !INTERRUPTED.load(Ordering::Relaxed)
+                && crate::console::failure().is_none()
+                && opts.stop_after_steps.is_none_or(|n| steps < n)
         });
         stepping += ts0.elapsed().as_secs_f64();
         rate = format!("{:.3e} particle-steps/s", particles * scene.steps() as f64 / stepping.max(1e-9));
@@ -223,7 +226,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 // The state the check stopped, as the last snapshot of the series: what blew
                 // up and where, for ParaView. Best effort: the divergence is the result.
                 if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
-                    eprintln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
+                    errln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
                 }
                 break Outcome::Diverged(d);
             }
@@ -248,9 +251,9 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             last_checkpoint = Instant::now();
         }
         if !reached {
-            break Outcome::Failed(
-                "interrupted (checkpoint written: the next run of this case resumes)".into(),
-            );
+            // Stopped by a signal, or by a message that could not be written.
+            let why = crate::console::failure().unwrap_or_else(|| "interrupted".into());
+            break Outcome::Failed(format!("{why} (checkpoint written: the next run of this case resumes)"));
         }
     };
     progress.finish();
