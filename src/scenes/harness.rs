@@ -6,6 +6,7 @@ use super::{params::Params, SceneEntry, SceneRun};
 use crate::errln;
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
+use crate::solver::simulation::Divergence;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -67,6 +68,12 @@ impl std::fmt::Display for RunError {
 
 fn io_err(path: &Path, e: std::io::Error) -> String {
     format!("{}: {e}", path.display())
+}
+
+/// The first value of `row` (a time-series row or the metrics) that is not finite, as
+/// `(name, value)`.
+fn not_finite<'a>(row: impl IntoIterator<Item = (&'a str, f64)>) -> Option<(&'a str, f64)> {
+    row.into_iter().find(|(_, v)| !v.is_finite())
 }
 
 /// Runs `entry` with `params`, writing into `out`. Returns the summary (completed or
@@ -165,6 +172,13 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     // The particle-steps per second of the stepping so far, shown after each output.
     let mut rate = String::new();
     let eps = 1e-12 * tf.max(1.0);
+    // The state the run stopped in, as the last snapshot of the series: what blew up and
+    // where, for ParaView. Best effort: the divergence is the result.
+    let last_snapshot = |scene: &dyn SceneRun, index: usize, series: &mut BTreeMap<String, Series>| {
+        if let Err(e) = snapshot(scene, out, &vtu_dir, index, series) {
+            errln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
+        }
+    };
     let outcome = loop {
         let t = scene.time();
         let at_end = t >= tf - eps;
@@ -191,6 +205,13 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 break Outcome::Failed(format!("{}: {e}", ts_path.display()));
             }
             ts_rows += 1;
+            // A value that is not finite is a blow-up the solver's checks of the fields did
+            // not see (a norm over particles that all sit at one point, say).
+            if let Some((k, v)) = not_finite(row.iter().copied()) {
+                last_snapshot(scene.as_ref(), snapshot_index, &mut series);
+                let reason = format!("time-series value `{k}` = {v} is not finite");
+                break Outcome::Diverged(Divergence { reason, step: scene.steps(), time: t });
+            }
             while next_sample <= t + eps {
                 next_sample += sample_dt;
             }
@@ -205,7 +226,12 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             }
         }
         if at_end {
-            break Outcome::Completed;
+            let metrics = scene.metrics();
+            if let Some((k, v)) = not_finite(metrics.iter().map(|(k, v)| (k.as_str(), *v))) {
+                let reason = format!("metric `{k}` = {v} is not finite at the end of the run");
+                break Outcome::Diverged(Divergence { reason, step: scene.steps(), time: t });
+            }
+            break Outcome::Completed(metrics);
         }
         // Output happens at the first step boundary at or after each output time: steps
         // are never shortened for output, so the cadence does not change the solution.
@@ -223,11 +249,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let reached = match res {
             Ok(reached) => reached,
             Err(d) => {
-                // The state the check stopped, as the last snapshot of the series: what blew
-                // up and where, for ParaView. Best effort: the divergence is the result.
-                if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
-                    errln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
-                }
+                last_snapshot(scene.as_ref(), snapshot_index, &mut series);
                 break Outcome::Diverged(d);
             }
         };
@@ -258,7 +280,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     };
     progress.finish();
     let (status, reason, metrics) = match &outcome {
-        Outcome::Completed => (Status::Completed, None, scene.metrics()),
+        Outcome::Completed(m) => (Status::Completed, None, m.clone()),
         Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), BTreeMap::new()),
         Outcome::Failed(r) => (Status::Failed, Some(r.clone()), BTreeMap::new()),
     };
@@ -297,8 +319,9 @@ fn snapshot(
 }
 
 enum Outcome {
-    Completed,
-    Diverged(crate::solver::simulation::Divergence),
+    /// Reached `tf`, with these metrics, every one finite.
+    Completed(BTreeMap<String, f64>),
+    Diverged(Divergence),
     Failed(String),
 }
 

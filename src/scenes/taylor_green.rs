@@ -93,7 +93,9 @@ fn params<const D: usize>() -> Vec<Spec> {
     let mut v = vec![
         Spec::int("nx", 50, 1, "particles per side"),
         Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
-        Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx"),
+        // At most dx / 2 each way: a particle never passes its neighbour's lattice site.
+        Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx")
+            .at_most(1.0),
         Spec::int("seed", 1, 0, "seed of the initial perturbation"),
     ];
     if D == 3 {

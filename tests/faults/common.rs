@@ -7,6 +7,9 @@ use std::time::{Duration, Instant};
 
 pub const BIN: &str = env!("CARGO_BIN_EXE_sphrepro");
 
+/// How long one tiny case may take, on a loaded 2-core machine, before it counts as hung.
+pub const CASE_LIMIT: Duration = Duration::from_secs(60);
+
 /// What a finished process did.
 #[derive(Debug)]
 pub struct Ran {
@@ -61,9 +64,26 @@ pub fn run_limited(mut cmd: Command, scratch: &Path, limit: Duration) -> Result<
     })
 }
 
+/// `sphrepro simulate SCENE --quiet --out DIR --set ...` on one thread.
+pub fn simulate_cmd(scene: &str, out: &Path, sets: &[String]) -> Command {
+    let mut c = Command::new(BIN);
+    c.args(["--threads", "1", "simulate", scene, "--quiet", "--out"]).arg(out);
+    for s in sets {
+        c.arg("--set").arg(s);
+    }
+    c
+}
+
 /// `DIR/summary.json`, if there is a readable one.
 pub fn summary(dir: &Path) -> Option<serde_json::Value> {
     serde_json::from_slice(&std::fs::read(dir.join("summary.json")).ok()?).ok()
+}
+
+/// Runs one `simulate` (on one thread) within the case limit.
+pub fn simulate(dir: &Path, scene: &str, sets: &[&str]) -> Ran {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let scratch = tempfile::tempdir().unwrap();
+    run_limited(simulate_cmd(scene, dir, &sets), scratch.path(), CASE_LIMIT).unwrap()
 }
 
 /// A tiny problem of three Taylor-Green cases in a temporary folder.

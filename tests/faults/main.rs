@@ -9,4 +9,5 @@
 //! One module per kind of fault; `common` holds what they share.
 
 mod common;
+mod not_finite;
 mod output;
