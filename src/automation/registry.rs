@@ -13,6 +13,10 @@ use toml::Spanned;
 /// The preset used when none is named.
 pub const DEFAULT_PRESET: &str = "quick";
 
+/// The most cases a problem may have in a preset: far more than any runs (the largest
+/// problem has 65), few enough to expand and check at once.
+pub const MAX_CASES: usize = 10_000;
+
 /// A map of parameter values as written in a problem file.
 type RawParams = BTreeMap<String, Spanned<toml::Value>>;
 
@@ -511,7 +515,8 @@ pub fn parse_with(
     // resolution this machine cannot hold, ...), found before anything runs; for the preset
     // asked for only, since the others may be meant for a larger machine.
     for c in &problem.cases {
-        (scene.check)(&c.params)
+        crate::scenes::harness::check_times(scene.name, &c.params)
+            .and_then(|()| (scene.check)(&c.params))
             .map_err(|e| format!("{}: case `{}` (preset {preset}): {e}", path.display(), c.name))?;
     }
     Ok(problem)
@@ -753,7 +758,18 @@ impl Expand<'_> {
                 set_keys.retain(|(s, _)| s != k);
                 set_keys.push((k.clone(), vals));
             }
-            // Product of the grid (like automan's mdict/dprod).
+            // Product of the grid (like automan's mdict/dprod), counted before it is made:
+            // seven lists of ten values would make ten million cases.
+            let count = set_keys.iter().fold(1f64, |n, (_, vals)| n * vals.len() as f64);
+            if cases.len() as f64 + count > MAX_CASES as f64 {
+                return Err(loc.err(
+                    gspan.clone(),
+                    "cases.grid",
+                    format!(
+                        "this group makes {count:.0} case(s), which brings the problem past {MAX_CASES}: more than one problem can run"
+                    ),
+                ));
+            }
             let mut combos: Vec<Params> = vec![fixed];
             for (k, vals) in &set_keys {
                 combos = combos

@@ -55,7 +55,10 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             Bound::Positive,
             "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
         ),
-        Spec::int("ipst_max_iter", paper::IPST_MAX_ITER as i64, 1, "IPST iterations per step at most"),
+        // Bounded: a step's sweeps do not see Ctrl-C, and a tolerance no sweep meets would
+        // otherwise make one step last forever.
+        Spec::int("ipst_max_iter", paper::IPST_MAX_ITER as i64, 1, "IPST iterations per step at most")
+            .at_most(1000.0),
         Spec::int(
             "ipst_interval",
             paper::IPST_INTERVAL as i64,

@@ -11,3 +11,4 @@
 mod common;
 mod not_finite;
 mod output;
+mod times;
