@@ -217,6 +217,10 @@ enum Command {
         /// Stop after N steps as if interrupted, checkpointing first (tests the resume path).
         #[arg(long, hide = true)]
         stop_after_steps: Option<u64>,
+        /// The lock of the output folder, held by the runner that started this run and
+        /// handed down as this open file descriptor (otherwise the run takes the lock).
+        #[arg(long, hide = true)]
+        lock_fd: Option<i32>,
     },
     /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
     Bench(BenchArgs),
@@ -348,10 +352,12 @@ fn run(cli: Cli) -> u8 {
             progress_file,
             checkpoint_every,
             stop_after_steps,
+            lock_fd,
         } => simulate(
             &scene,
             &sets,
             &out,
+            lock_fd,
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
         Command::Bench(args) => run_bench(args),
@@ -365,10 +371,32 @@ fn run(cli: Cli) -> u8 {
 }
 
 /// `simulate`: one run of `scene` into `out`; exit 0 when it completes, 3 when it diverges
-/// (a result, reported as such), 2 on bad input and 1 when the run fails.
-fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::RunOptions) -> u8 {
-    let (entry, params) = match scenes::find(scene).and_then(|e| Ok((e, e.params_from_sets(sets)?))) {
+/// (a result, reported as such), 2 on bad input (or an output folder another run is
+/// writing) and 1 when the run fails. The run holds the lock of `out` while it lives: its
+/// own, or the runner's, handed down as the open descriptor `lock_fd`.
+fn simulate(
+    scene: &str,
+    sets: &[String],
+    out: &std::path::Path,
+    lock_fd: Option<i32>,
+    opts: harness::RunOptions,
+) -> u8 {
+    let found = scenes::find(scene).and_then(|e| {
+        let params = e.params_from_sets(sets)?;
+        // Every check that needs no particle, before the lock file is made.
+        harness::check_times(e.name, &params)?;
+        (e.check)(&params)?;
+        Ok((e, params))
+    });
+    let (entry, params) = match found {
         Ok(found) => found,
+        Err(e) => {
+            errln!("error: {e}");
+            return 2;
+        }
+    };
+    let _lock = match lock_output(out, lock_fd) {
+        Ok(lock) => lock,
         Err(e) => {
             errln!("error: {e}");
             return 2;
@@ -408,6 +436,35 @@ fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::
             errln!("failed: {e}");
             1
         }
+    }
+}
+
+/// The lock `simulate` holds on its output folder while it runs.
+enum OutputLock {
+    #[allow(dead_code)] // held for its drop
+    Own(sphrepro::automation::lock::Lock),
+    #[cfg(unix)]
+    #[allow(dead_code)] // held for its drop
+    Inherited(sphrepro::automation::lock::Inherited),
+}
+
+/// Takes the lock of `out` (or takes up the runner's, handed down as `fd`): a folder
+/// another run is writing into is refused, naming the folder and that run's process.
+fn lock_output(out: &std::path::Path, fd: Option<i32>) -> Result<OutputLock, String> {
+    use sphrepro::automation::lock::{normalize, Lock, Try};
+    match fd {
+        #[cfg(unix)]
+        Some(fd) => Lock::adopt(out, fd).map(OutputLock::Inherited),
+        #[cfg(not(unix))]
+        Some(_) => Err("--lock-fd: only on unix".into()),
+        None => match Lock::try_take(out)? {
+            Try::Taken(lock) => Ok(OutputLock::Own(lock)),
+            Try::Held(pid) => Err(format!(
+                "{}: another run ({}) is writing into this folder; wait for it to end, or choose another --out",
+                normalize(out).display(),
+                if pid == 0 { "just starting".to_string() } else { format!("process {pid}") }
+            )),
+        },
     }
 }
 

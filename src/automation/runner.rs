@@ -257,7 +257,10 @@ fn run_one(
     };
     cmd.stdout(Stdio::from(log)).stderr(Stdio::from(log2));
     #[cfg(unix)]
-    bind_to_runner(&mut cmd, lock.inherit_fd());
+    {
+        cmd.arg("--lock-fd").arg(lock.inherit_fd().to_string());
+        bind_to_runner(&mut cmd, lock.inherit_fd());
+    }
     let t0 = Instant::now();
     let mut child = match cmd.spawn() {
         Ok(c) => c,

@@ -12,3 +12,4 @@ mod common;
 mod not_finite;
 mod output;
 mod times;
+mod two_writers;
