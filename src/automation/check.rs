@@ -97,6 +97,7 @@ pub fn state_word(s: &State) -> String {
             .and_then(|v| v.as_str().map(String::from))
             .unwrap_or_else(|| "done".into()),
         State::Failed(r) => format!("failed: {r}"),
+        State::Damaged(r) => r.clone(),
         State::Missing(Some(c)) => format!("stale: {c}"),
         State::Missing(None) => "missing".into(),
     }
@@ -109,6 +110,8 @@ pub struct StatusCounts {
     pub done: usize,
     /// Failed or killed.
     pub failed: usize,
+    /// With a summary that cannot be read.
+    pub damaged: usize,
     /// Never run, or run with other inputs.
     pub missing: usize,
     /// Folders that belong to no current case.
@@ -137,6 +140,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
             match st {
                 State::Done(_) => n.done += 1,
                 State::Failed(_) => n.failed += 1,
+                State::Damaged(_) => n.damaged += 1,
                 State::Missing(_) => n.missing += 1,
             }
             let running = super::lock::Lock::holder(&e.dir).is_some();
@@ -146,6 +150,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                     State::Done(_) => "done",
                     State::Failed(_) if running => "running",
                     State::Failed(_) => "failed",
+                    State::Damaged(_) => "damaged",
                     State::Missing(Some(_)) => "stale",
                     State::Missing(None) => "missing",
                 },
@@ -158,6 +163,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                         e.dir.join("run.log").display()
                     ),
                     State::Failed(r) => format!("  ({r}; log {})", e.dir.join("run.log").display()),
+                    State::Damaged(r) => format!("  ({r})"),
                     State::Missing(Some(c)) => format!("  (inputs changed: {c})"),
                     State::Missing(None) => String::new(),
                 }
@@ -204,8 +210,9 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
             outln!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
         }
     }
+    let damaged = if n.damaged > 0 { format!(", {} damaged", n.damaged) } else { String::new() };
     outln!(
-        "{} done, {} failed, {} missing, {} stale folder(s)",
+        "{} done, {} failed{damaged}, {} missing, {} stale folder(s)",
         n.done,
         n.failed,
         n.missing,

@@ -111,13 +111,20 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
     };
     let mut status = OK;
     if !flags.plot_only {
-        let (tasks, done) = match runner::plan(&dirs.output, &problems, opts) {
+        let runner::Plan { tasks, done, damaged } = match runner::plan(&dirs.output, &problems, opts) {
             Ok(t) => t,
             Err(e) => {
                 errln!("error: {e}");
                 return BAD_INPUT;
             }
         };
+        // A damaged result is not a crash to rerun over: named, with the command that does.
+        for d in &damaged {
+            errln!("error: {d}");
+        }
+        if !damaged.is_empty() {
+            status = FAILED;
+        }
         if opts.dry_run {
             for t in &tasks {
                 outln!(
@@ -182,6 +189,24 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
         // Figures of nothing would overwrite the last ones drawn from results (a mistyped
         // --output, every case failed): leave them, and say so.
         let entries = super::cache::entries(&dirs.output, p);
+        // Nor are they drawn without a case whose result is damaged (it would be left out).
+        let damaged: Vec<String> = entries
+            .iter()
+            .filter_map(|e| match e.state() {
+                cache::State::Damaged(r) => Some(format!("{}/{}: {r}", p.name, e.case.name)),
+                _ => None,
+            })
+            .collect();
+        if !damaged.is_empty() {
+            // Without --plot-only the runner has named them already.
+            let named =
+                if flags.plot_only { format!("{}\n", damaged.join("\nerror: ")) } else { String::new() };
+            errors.push(format!(
+                "{named}{}: a case's result is damaged; its figures and tables are left as they were",
+                p.name
+            ));
+            continue;
+        }
         if !entries.is_empty() && !entries.iter().any(|e| e.is_done()) {
             errors.push(format!(
                 "{}: no case has a result under {}; its figures and tables are left as they were",
@@ -236,7 +261,7 @@ pub fn status(dirs: &Dirs, preset: &str, list_stale: bool) -> u8 {
     match load(dirs, preset, &[]) {
         Ok(ps) => {
             let n = check::status(&dirs.output, &ps, list_stale);
-            if n.failed + n.missing == 0 {
+            if n.failed + n.damaged + n.missing == 0 {
                 OK
             } else {
                 FAILED

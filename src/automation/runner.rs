@@ -58,14 +58,27 @@ pub struct Report {
     pub interrupted: bool,
 }
 
-/// The cases of `problems` that must run, with the reason, and how many are done.
-pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<Task>, usize), String> {
+/// What a run of some problems has to do.
+#[derive(Debug, Default)]
+pub struct Plan {
+    /// The cases that must run, each with the reason.
+    pub tasks: Vec<Task>,
+    /// How many are done.
+    pub done: usize,
+    /// The cases whose result is damaged, each as `problem/case: what is wrong and the
+    /// command that computes it again`: not run unless forced.
+    pub damaged: Vec<String>,
+}
+
+/// The cases of `problems` that must run, with the reason, how many are done, and which
+/// are damaged.
+pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<Plan, String> {
     let matcher = match &opts.matching {
         Some(g) => Some(globset::Glob::new(g).map_err(|e| format!("--match `{g}`: {e}"))?.compile_matcher()),
         None => None,
     };
-    let mut tasks = Vec::new();
-    let (mut done, mut matched) = (0, 0);
+    let mut plan = Plan::default();
+    let mut matched = 0;
     for p in problems {
         for e in super::cache::entries(output, p) {
             if let Some(m) = &matcher {
@@ -77,7 +90,12 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
             let reason = match e.state() {
                 State::Done(_) if opts.force => "forced".to_string(),
                 State::Done(_) => {
-                    done += 1;
+                    plan.done += 1;
+                    continue;
+                }
+                State::Damaged(_) if opts.force => "forced over a damaged result".to_string(),
+                State::Damaged(r) => {
+                    plan.damaged.push(format!("{}/{}: {r}", p.name, e.case.name));
                     continue;
                 }
                 State::Failed(r) => match Lock::holder(&e.dir) {
@@ -87,14 +105,14 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
                 State::Missing(Some(change)) => format!("stale: {change}"),
                 State::Missing(None) => "missing".to_string(),
             };
-            tasks.push(Task { problem: p.name.clone(), entry: e, reason });
+            plan.tasks.push(Task { problem: p.name.clone(), entry: e, reason });
         }
     }
     // A pattern that selects nothing is a typo, not a request to run nothing.
     if let (Some(g), 0) = (&opts.matching, matched) {
         return Err(format!("--match `{g}`: no case of the selected problems matches it"));
     }
-    Ok((tasks, done))
+    Ok(plan)
 }
 
 /// Concurrent cases and rayon threads per case for `tasks` cases within a budget of
@@ -308,6 +326,7 @@ fn run_one(
             Outcome::Failed(format!("bad input: {}", last_error(&e.dir.join("run.log"))))
         }
         State::Failed(r) => Outcome::Failed(format!("{r} ({code})")),
+        State::Damaged(r) => Outcome::Failed(format!("{r} ({code})")),
         State::Missing(_) => Outcome::Failed(format!("no result ({code})")),
     }
 }

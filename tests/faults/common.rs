@@ -139,4 +139,14 @@ impl Problem {
         let scratch = self.root.join(format!("scratch-{}", args.join("-").replace('/', "_")));
         run_limited(self.cmd(args), &scratch, Duration::from_secs(120)).unwrap()
     }
+    pub fn case_dir(&self, name: &str) -> PathBuf {
+        std::fs::read_dir(self.root.join("output/tiny"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .find(|p| {
+                p.is_dir() && p.file_name().unwrap().to_string_lossy().rsplit_once('-').unwrap().0 == name
+            })
+            .unwrap_or_else(|| panic!("no folder for case {name}"))
+    }
 }

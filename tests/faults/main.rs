@@ -9,6 +9,7 @@
 //! One module per kind of fault; `common` holds what they share.
 
 mod common;
+mod damaged;
 mod not_finite;
 mod output;
 mod times;
