@@ -189,9 +189,17 @@ impl Entry {
                 "damaged result: {e}; {} computes it again",
                 recompute_command(&self.record.problem, &self.preset, &self.case.name)
             )),
+            // A folder where no simulation started (its runner died writing `case.json`):
+            // no log and nothing to resume.
+            Err(_) if self.dir.exists() && !self.started() => State::Missing(self.previous_change()),
             Err(_) if self.dir.exists() => State::Failed("no summary: the run was killed or crashed".into()),
             Err(_) => State::Missing(self.previous_change()),
         }
+    }
+
+    /// Whether a simulation of the case started in its folder (a log or a checkpoint).
+    fn started(&self) -> bool {
+        self.dir.join("run.log").exists() || self.dir.join("checkpoint.json").exists()
     }
 
     /// Whether the case is done.

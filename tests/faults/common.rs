@@ -28,6 +28,9 @@ impl Ran {
             self.code, self.signal, self.stdout, self.stderr
         )
     }
+    pub fn panicked(&self) -> bool {
+        self.stderr.contains("panicked") || self.code == Some(101)
+    }
 }
 
 /// Runs `cmd` with its output in files under `scratch` (a pipe could fill up and stall a
@@ -115,6 +118,15 @@ y = "l1_velocity"
 metric = "l1_velocity_final"
 cases = ["b"]
 max = 10.0
+"#;
+
+/// One case of a few seconds, to be interrupted.
+pub const ONE_SLOW_CASE: &str = r#"title = "one slow case"
+scene = "taylor_green"
+[presets.quick]
+[[cases]]
+name = "a"
+params = { nx = 16, tf = 20.0 }
 "#;
 
 impl Problem {

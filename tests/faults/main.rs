@@ -10,7 +10,9 @@
 
 mod common;
 mod damaged;
+mod disk;
 mod not_finite;
 mod output;
+mod resume;
 mod times;
 mod two_writers;

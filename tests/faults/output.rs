@@ -3,6 +3,7 @@
 
 use crate::common::*;
 use std::process::{Command, Stdio};
+use std::time::Duration;
 
 /// Standard output on a full device: `list`, `status`, `check` and `run` end with an error
 /// naming stdout and the cause, exit 1, no panic; `run`'s results are still true results.
@@ -44,4 +45,37 @@ fn simulate_with_stderr_on_a_full_device_fails_naming_it() {
     assert_eq!(s["status"], "failed");
     let reason = s["reason"].as_str().unwrap();
     assert!(reason.contains("stderr") && reason.contains("No space left on device"), "{reason}");
+}
+
+/// `run | head -2`: the runner ends quietly when its reader goes, and leaves no case
+/// `failed` with a log that does not exist; the next run does every case.
+#[cfg(unix)]
+#[test]
+fn a_closed_pipe_ends_the_runner_quietly() {
+    use std::io::BufRead;
+    let p = Problem::new(THREE_CASES);
+    for lines in [1, 2, 3, 4] {
+        let _ = std::fs::remove_dir_all(p.root.join("output"));
+        let mut c = p.cmd(&["run", "tiny", "--jobs", "1"]);
+        let mut child = c.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+        let mut reader = std::io::BufReader::new(child.stdout.take().unwrap());
+        for _ in 0..lines {
+            let mut l = String::new();
+            reader.read_line(&mut l).unwrap();
+        }
+        drop(reader);
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!err.contains("panicked") && !err.contains("error"), "after {lines} line(s): {err}");
+        // Any case left behind is resumable or missing, never failed with a missing log.
+        std::thread::sleep(Duration::from_millis(300));
+        let s = p.run(&["status"]);
+        for l in s.stdout.lines().filter(|l| l.contains("failed") && l.contains("log ")) {
+            let log = l.rsplit("log ").next().unwrap().trim_end_matches(')');
+            assert!(p.root.join(log).exists(), "after {lines} line(s): {l}\n{}", s.text());
+        }
+    }
+    let o = p.run(&["run", "tiny"]);
+    assert_eq!(o.code, Some(0), "{}", o.text());
+    assert!(p.run(&["status"]).stdout.contains("3 done, 0 failed, 0 missing"));
 }
