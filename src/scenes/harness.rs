@@ -122,6 +122,27 @@ fn not_finite<'a>(row: impl IntoIterator<Item = (&'a str, f64)>) -> Option<(&'a 
     row.into_iter().find(|(_, v)| !v.is_finite())
 }
 
+/// Removes the snapshots an earlier run left in `out` (its `.pvd` series and their `vtu/`
+/// files), so that a run started afresh there lists what the folder holds.
+fn remove_old_snapshots(out: &Path, vtu_dir: &Path) -> std::io::Result<()> {
+    for e in std::fs::read_dir(vtu_dir)? {
+        let path = e?.path();
+        if path.extension().is_some_and(|x| x == "vtu") {
+            std::fs::remove_file(&path)?;
+        }
+    }
+    for e in std::fs::read_dir(out)? {
+        let path = e?.path();
+        // A series of ours: a `.pvd` whose snapshots are under `vtu/`.
+        if path.extension().is_some_and(|x| x == "pvd")
+            && std::fs::read_to_string(&path).is_ok_and(|s| s.contains("file=\"vtu/"))
+        {
+            std::fs::remove_file(&path)?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs `entry` with `params`, writing into `out`. Returns the summary (completed or
 /// diverged), or an error.
 pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
@@ -204,6 +225,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         }
         None => {
             let _ = std::fs::remove_file(&ckpt_path);
+            remove_old_snapshots(out, &vtu_dir).map_err(|e| RunError::Input(io_err(out, e)))?;
             std::fs::File::create(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
         }
     }

@@ -11,8 +11,10 @@
 mod common;
 mod damaged;
 mod disk;
+mod memory;
 mod not_finite;
 mod output;
 mod resume;
+mod snapshots;
 mod times;
 mod two_writers;
