@@ -225,8 +225,9 @@ fn check_step_count(scene: &str, p: &Params, h: f64, c: &FluidConstants) -> Resu
     let steps = tf / dt;
     if steps > MAX_STEPS {
         return Err(format!(
-            "scene `{scene}`: `tf` = {tf} s needs {steps:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit), more than {MAX_STEPS:.0e}: check {}",
+            "scene `{scene}`: `tf` = {tf} s needs {steps:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit at `cfl` = {}), more than {MAX_STEPS:.0e}: check {}",
             limit.name(),
+            p.float("cfl"),
             match limit {
                 TimeStepLimit::Viscous => "the viscosity (re)",
                 TimeStepLimit::BodyForce => "gravity",

@@ -59,7 +59,7 @@ struct Tank {
 /// The constants, kernel, smoothing length and scheme, once every parameter check that
 /// needs no particle has passed.
 fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
-    column(p).setup("hydrostatic_tank", ["width", "height"], p)
+    column(p).setup("hydrostatic_tank", ["width", "height", "width", "height"], p)
 }
 
 /// The fluid column in a tank as wide and half as high again.

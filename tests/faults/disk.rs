@@ -65,3 +65,25 @@ fn a_full_disk_is_reported_with_the_path_and_the_cause() {
     assert!(!ran.panicked(), "{}", ran.text());
     assert!(summary(&out).is_none_or(|s| s["status"] == "failed"));
 }
+
+/// A read-only output folder: `run` and `simulate` end with an error naming the path and
+/// the cause, without a panic, and write nothing.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_read_only_output_folder_is_reported_with_the_path_and_the_cause() {
+    let p = Problem::new(THREE_CASES);
+    let ro = p.root.join("ro");
+    let Some(_mount) =
+        Tmpfs::mount(&ro, "size=64k,ro", "a_read_only_output_folder_is_reported_with_the_path_and_the_cause")
+    else {
+        return;
+    };
+    let o = p.run(&["run", "tiny", "--output", "ro/output"]);
+    let t = o.text();
+    assert_eq!(o.code, Some(1), "{t}");
+    assert!(t.contains("ro/output") && t.contains("Read-only file system") && !o.panicked(), "{t}");
+    let ran = simulate(&ro.join("sim"), "taylor_green", &["nx=16", "tf=0.02"]);
+    assert!(matches!(ran.code, Some(1) | Some(2)), "{}", ran.text());
+    assert!(ran.stderr.contains("Read-only file system") && ran.stderr.contains(&ro.display().to_string()));
+    assert!(!ran.panicked(), "{}", ran.text());
+}

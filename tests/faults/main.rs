@@ -11,9 +11,11 @@
 mod common;
 mod damaged;
 mod disk;
+mod hostile;
 mod memory;
 mod not_finite;
 mod output;
+mod problem_files;
 mod resume;
 mod snapshots;
 mod times;
