@@ -13,8 +13,8 @@ use toml::Spanned;
 /// The preset used when none is named.
 pub const DEFAULT_PRESET: &str = "quick";
 
-/// The most cases a problem may have in a preset: far more than any runs (the largest
-/// problem has 65), few enough to expand and check at once.
+/// The most cases a problem may have in a preset: far more than any problem here runs,
+/// few enough to expand and check at once.
 pub const MAX_CASES: usize = 10_000;
 
 /// A map of parameter values as written in a problem file.
