@@ -14,6 +14,7 @@
 
 pub mod automation;
 pub mod bench;
+pub mod console;
 pub mod scenes;
 pub mod solver;
 

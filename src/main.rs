@@ -5,6 +5,7 @@ use sphrepro::automation::commands::{self, Dirs, RunFlags};
 use sphrepro::automation::runner;
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
+use sphrepro::{errln, outln};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -221,6 +222,10 @@ enum Command {
         /// Stop after N steps as if interrupted, checkpointing first (tests the resume path).
         #[arg(long, hide = true)]
         stop_after_steps: Option<u64>,
+        /// The lock of the output folder, held by the runner that started this run and
+        /// handed down as this open file descriptor (otherwise the run takes the lock).
+        #[arg(long, hide = true)]
+        lock_fd: Option<i32>,
     },
     /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
     Bench(BenchArgs),
@@ -266,7 +271,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     if let Some(n) = cli.threads {
         if let Err(e) = rayon::ThreadPoolBuilder::new().num_threads(n).build_global() {
-            eprintln!("error: cannot start {n} threads: {e}");
+            errln!("error: cannot start {n} threads: {e}");
             return ExitCode::from(2);
         }
     }
@@ -275,7 +280,15 @@ fn main() -> ExitCode {
     // from inside it, without handing each one over from a thread outside the pool, which
     // costs a sleep and a wake-up per loop (measured: 15 % more particle-steps per second on
     // one thread at 2 500 particles).
-    rayon::scope(|_| run(cli))
+    let code = rayon::scope(|_| run(cli));
+    // Output that could not be written is an error, whatever the command did otherwise.
+    match sphrepro::console::failure() {
+        Some(e) => {
+            errln!("error: {e}");
+            ExitCode::from(if code == 0 { 1 } else { code })
+        }
+        None => ExitCode::from(code),
+    }
 }
 
 /// Ctrl-C, SIGTERM and SIGHUP stop a run with a checkpoint (a second one exits at once).
@@ -308,34 +321,33 @@ fn install_signal_handlers() {
     }
 }
 
-fn run(cli: Cli) -> ExitCode {
+/// Runs the command; returns its exit status.
+fn run(cli: Cli) -> u8 {
     match cli.command {
         Command::List { preset, dirs } => {
             let code = commands::list(&dirs.dirs(), &preset);
             if code != 0 {
-                return ExitCode::from(code);
+                return code;
             }
             print_scenes();
-            ExitCode::SUCCESS
+            0
         }
-        Command::Run { problem, args } => ExitCode::from(commands::run(
+        Command::Run { problem, args } => commands::run(
             &args.dirs.dirs(),
             &args.preset,
             &problem,
             &args.options(),
             &RunFlags { plot_only: args.plot_only, manuscript: false },
-        )),
-        Command::Reproduce { args } => ExitCode::from(commands::run(
+        ),
+        Command::Reproduce { args } => commands::run(
             &args.dirs.dirs(),
             &args.preset,
             &[],
             &args.options(),
             &RunFlags { plot_only: args.plot_only, manuscript: true },
-        )),
-        Command::Status { preset, stale, dirs } => {
-            ExitCode::from(commands::status(&dirs.dirs(), &preset, stale))
-        }
-        Command::Check { preset, dirs } => ExitCode::from(commands::check(&dirs.dirs(), &preset)),
+        ),
+        Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(), &preset, stale),
+        Command::Check { preset, dirs } => commands::check(&dirs.dirs(), &preset),
         Command::Simulate {
             scene,
             sets,
@@ -345,72 +357,125 @@ fn run(cli: Cli) -> ExitCode {
             progress_file,
             checkpoint_every,
             stop_after_steps,
+            lock_fd,
         } => simulate(
             &scene,
             &sets,
             &out,
+            lock_fd,
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
-        Command::Bench(args) => ExitCode::from(bench::run(&args.options())),
-        Command::BenchCase { variant, nx, steps, kernel } => {
-            ExitCode::from(bench::case_child(&variant, nx, steps, &kernel))
-        }
+        Command::Bench(args) => bench::run(&args.options()),
+        Command::BenchCase { variant, nx, steps, kernel } => bench::case_child(&variant, nx, steps, &kernel),
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => {
-            ExitCode::from(bench::interleaved_child(&variants, nx, &bench_threads, steps, rounds, &kernel))
+            bench::interleaved_child(&variants, nx, &bench_threads, steps, rounds, &kernel)
         }
     }
 }
 
 /// `simulate`: one run of `scene` into `out`; exit 0 when it completes, 3 when it diverges
-/// (a result, reported as such), 2 on bad input and 1 when the run fails.
-fn simulate(scene: &str, sets: &[String], out: &std::path::Path, opts: harness::RunOptions) -> ExitCode {
-    let (entry, params) = match scenes::find(scene).and_then(|e| Ok((e, e.params_from_sets(sets)?))) {
+/// (a result, reported as such), 2 on bad input (or an output folder another run is
+/// writing) and 1 when the run fails. The run holds the lock of `out` while it lives: its
+/// own, or the runner's, handed down as the open descriptor `lock_fd`.
+fn simulate(
+    scene: &str,
+    sets: &[String],
+    out: &std::path::Path,
+    lock_fd: Option<i32>,
+    opts: harness::RunOptions,
+) -> u8 {
+    let found = scenes::find(scene).and_then(|e| {
+        let params = e.params_from_sets(sets)?;
+        // Every check that needs no particle, before the lock file is made.
+        harness::check_times(e.name, &params)?;
+        (e.check)(&params)?;
+        Ok((e, params))
+    });
+    let (entry, params) = match found {
         Ok(found) => found,
         Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::from(2);
+            errln!("error: {e}");
+            return 2;
+        }
+    };
+    let _lock = match lock_output(out, lock_fd) {
+        Ok(lock) => lock,
+        Err(e) => {
+            errln!("error: {e}");
+            return 2;
         }
     };
     match harness::run(entry, &params, out, &opts) {
         Ok(s) => match s.status {
             sphrepro::solver::output::summary::Status::Completed => {
                 if !opts.quiet {
-                    eprintln!(
+                    errln!(
                         "completed: {} steps, {:.2} s, {:.3e} particle-steps/s",
-                        s.steps, s.wall_seconds, s.particle_steps_per_second
+                        s.steps,
+                        s.wall_seconds,
+                        s.particle_steps_per_second
                     );
                     for (k, v) in &s.metrics {
-                        eprintln!("  {k} = {v:.6e}");
+                        errln!("  {k} = {v:.6e}");
                     }
                 }
-                ExitCode::SUCCESS
+                0
             }
             _ => {
-                eprintln!(
+                errln!(
                     "diverged at step {} (t = {}): {}",
                     s.step.unwrap_or(s.steps),
                     s.final_time,
                     s.reason.as_deref().unwrap_or("")
                 );
-                ExitCode::from(3)
+                3
             }
         },
         Err(harness::RunError::Input(e)) => {
-            eprintln!("error: {e}");
-            ExitCode::from(2)
+            errln!("error: {e}");
+            2
         }
         Err(harness::RunError::Failed(e)) => {
-            eprintln!("failed: {e}");
-            ExitCode::from(1)
+            errln!("failed: {e}");
+            1
         }
+    }
+}
+
+/// The lock `simulate` holds on its output folder while it runs.
+enum OutputLock {
+    #[allow(dead_code)] // held for its drop
+    Own(sphrepro::automation::lock::Lock),
+    #[cfg(unix)]
+    #[allow(dead_code)] // held for its drop
+    Inherited(sphrepro::automation::lock::Inherited),
+}
+
+/// Takes the lock of `out` (or takes up the runner's, handed down as `fd`): a folder
+/// another run is writing into is refused, naming the folder and that run's process.
+fn lock_output(out: &std::path::Path, fd: Option<i32>) -> Result<OutputLock, String> {
+    use sphrepro::automation::lock::{normalize, Lock, Try};
+    match fd {
+        #[cfg(unix)]
+        Some(fd) => Lock::adopt(out, fd).map(OutputLock::Inherited),
+        #[cfg(not(unix))]
+        Some(_) => Err("--lock-fd: only on unix".into()),
+        None => match Lock::try_take(out)? {
+            Try::Taken(lock) => Ok(OutputLock::Own(lock)),
+            Try::Held(pid) => Err(format!(
+                "{}: another run ({}) is writing into this folder; wait for it to end, or choose another --out",
+                normalize(out).display(),
+                if pid == 0 { "just starting".to_string() } else { format!("process {pid}") }
+            )),
+        },
     }
 }
 
 /// The scenes, each with its parameters (name, kind, default, help) and metrics.
 fn print_scenes() {
-    println!("scenes:");
+    outln!("scenes:");
     for s in scenes::SCENES {
-        println!("{} ({}D): {}", s.name, s.dim, s.about);
+        outln!("{} ({}D): {}", s.name, s.dim, s.about);
         let params = (s.params)();
         // Columns as wide as the scene's widest entry, so that long names and
         // choice lists keep the help text aligned.
@@ -421,8 +486,8 @@ fn print_scenes() {
         let width = |c: usize| rows.iter().map(|r| r[c].len()).max().unwrap_or(0);
         let (w0, w1, w2) = (width(0), width(1), width(2));
         for [name, kind, default, help] in &rows {
-            println!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
+            outln!("    {name:<w0$} {kind:<w1$} default {default:<w2$} {help}");
         }
-        println!("    metrics: {}", s.metrics.join(", "));
+        outln!("    metrics: {}", s.metrics.join(", "));
     }
 }

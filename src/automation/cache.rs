@@ -147,6 +147,10 @@ pub enum State {
     Done(Status),
     /// A folder with a `failed` summary, or none (killed, crashed).
     Failed(String),
+    /// A `summary.json` that cannot be read (edited or damaged after it was written, which
+    /// `simulate` does atomically): what is wrong, and the command that computes the case
+    /// again. Not rerun unless asked (`--force`): the folder holds a run that finished.
+    Damaged(String),
     /// No folder. If a folder of the same case name with other inputs exists (not the
     /// current result of another preset), the change: the case is stale.
     Missing(Option<String>),
@@ -164,6 +168,15 @@ pub struct Entry {
     /// The folders of the current cases of the problem's other presets (filled by
     /// [`entries`]): their results are not earlier inputs of this case.
     others: Arc<HashSet<PathBuf>>,
+    /// The preset the case was expanded for (for the command that computes it again).
+    preset: String,
+}
+
+/// The command that computes case `case` of `problem` (in `preset`) again, over what its
+/// folder holds.
+pub fn recompute_command(problem: &str, preset: &str, case: &str) -> String {
+    let preset = if preset == "quick" { String::new() } else { format!(" --preset {preset}") };
+    format!("`sphrepro run {problem}{preset} --match {case} --force`")
 }
 
 impl Entry {
@@ -171,7 +184,7 @@ impl Entry {
     pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
         let record = CaseRecord::new(&problem.name, case);
         let dir = output.join(&problem.name).join(record.folder());
-        Self { case: case.clone(), record, dir, others: Arc::default() }
+        Self { case: case.clone(), record, dir, others: Arc::default(), preset: problem.preset.clone() }
     }
 
     /// The summary, if there is a readable one.
@@ -184,9 +197,21 @@ impl Entry {
         match Summary::read(&self.dir) {
             Ok(s) if matches!(s.status, Status::Completed | Status::Diverged) => State::Done(s.status),
             Ok(s) => State::Failed(s.reason.unwrap_or_else(|| "failed".into())),
+            Err(e) if self.dir.join("summary.json").exists() => State::Damaged(format!(
+                "damaged result: {e}; {} computes it again",
+                recompute_command(&self.record.problem, &self.preset, &self.case.name)
+            )),
+            // A folder where no simulation started (its runner died writing `case.json`):
+            // no log and nothing to resume.
+            Err(_) if self.dir.exists() && !self.started() => State::Missing(self.previous_change()),
             Err(_) if self.dir.exists() => State::Failed("no summary: the run was killed or crashed".into()),
             Err(_) => State::Missing(self.previous_change()),
         }
+    }
+
+    /// Whether a simulation of the case started in its folder (a log or a checkpoint).
+    fn started(&self) -> bool {
+        self.dir.join("run.log").exists() || self.dir.join("checkpoint.json").exists()
     }
 
     /// Whether the case is done.

@@ -3,6 +3,7 @@
 
 use super::cache::{self, State};
 use super::registry::Problem;
+use crate::outln;
 use crate::solver::output::summary::Status;
 use std::path::Path;
 
@@ -96,6 +97,7 @@ pub fn state_word(s: &State) -> String {
             .and_then(|v| v.as_str().map(String::from))
             .unwrap_or_else(|| "done".into()),
         State::Failed(r) => format!("failed: {r}"),
+        State::Damaged(r) => r.clone(),
         State::Missing(Some(c)) => format!("stale: {c}"),
         State::Missing(None) => "missing".into(),
     }
@@ -108,6 +110,8 @@ pub struct StatusCounts {
     pub done: usize,
     /// Failed or killed.
     pub failed: usize,
+    /// With a summary that cannot be read.
+    pub damaged: usize,
     /// Never run, or run with other inputs.
     pub missing: usize,
     /// Folders that belong to no current case.
@@ -129,22 +133,24 @@ fn progress(dir: &Path) -> Option<(f64, f64)> {
 pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCounts {
     let mut n = StatusCounts::default();
     for p in problems {
-        println!("{} ({}, preset {}):", p.name, p.title, p.preset);
+        outln!("{} ({}, preset {}):", p.name, p.title, p.preset);
         let entries = cache::entries(output, p);
         for e in &entries {
             let st = e.state();
             match st {
                 State::Done(_) => n.done += 1,
                 State::Failed(_) => n.failed += 1,
+                State::Damaged(_) => n.damaged += 1,
                 State::Missing(_) => n.missing += 1,
             }
             let running = super::lock::Lock::holder(&e.dir).is_some();
-            println!(
+            outln!(
                 "  {:<10} {}{}",
                 match st {
                     State::Done(_) => "done",
                     State::Failed(_) if running => "running",
                     State::Failed(_) => "failed",
+                    State::Damaged(_) => "damaged",
                     State::Missing(Some(_)) => "stale",
                     State::Missing(None) => "missing",
                 },
@@ -157,6 +163,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                         e.dir.join("run.log").display()
                     ),
                     State::Failed(r) => format!("  ({r}; log {})", e.dir.join("run.log").display()),
+                    State::Damaged(r) => format!("  ({r})"),
                     State::Missing(Some(c)) => format!("  (inputs changed: {c})"),
                     State::Missing(None) => String::new(),
                 }
@@ -175,12 +182,12 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
         }
         let live: Vec<_> = current.iter().map(|e| e.dir.clone()).collect();
         if other_presets > 0 {
-            println!("  {other_presets} folder(s) with the results of the problem's other preset(s)");
+            outln!("  {other_presets} folder(s) with the results of the problem's other preset(s)");
         }
         let stale = cache::stale_folders(output, &p.name, &live);
         n.stale_folders += stale.len();
         if !list_stale && !stale.is_empty() {
-            println!(
+            outln!(
                 "  {} stale folder(s): results of earlier inputs, kept, not deleted (`status --stale` lists them)",
                 stale.len()
             );
@@ -200,12 +207,16 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                     }
                 })
                 .unwrap_or_else(|| "no case.json".into());
-            println!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
+            outln!("  {:<10} {}  ({why}; kept, not deleted)", "stale", s.display());
         }
     }
-    println!(
-        "{} done, {} failed, {} missing, {} stale folder(s)",
-        n.done, n.failed, n.missing, n.stale_folders
+    let damaged = if n.damaged > 0 { format!(", {} damaged", n.damaged) } else { String::new() };
+    outln!(
+        "{} done, {} failed{damaged}, {} missing, {} stale folder(s)",
+        n.done,
+        n.failed,
+        n.missing,
+        n.stale_folders
     );
     n
 }

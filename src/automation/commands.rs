@@ -4,6 +4,7 @@
 use super::registry::{self, Problem};
 use super::runner::{self, Options};
 use super::{cache, check};
+use crate::{errln, outln};
 use std::path::{Path, PathBuf};
 
 /// The problems folder when none is named: `problems/` of the checkout.
@@ -51,7 +52,7 @@ pub fn list(dirs: &Dirs, preset: &str) -> u8 {
     match load(dirs, preset, &[]) {
         Ok(ps) => {
             for p in &ps {
-                println!(
+                outln!(
                     "{} ({}): {} case(s) in preset {}, scene {}",
                     p.name,
                     p.title,
@@ -60,7 +61,7 @@ pub fn list(dirs: &Dirs, preset: &str) -> u8 {
                     p.scene.name
                 );
                 for c in &p.cases {
-                    println!("    {}", c.name);
+                    outln!("    {}", c.name);
                 }
             }
             OK
@@ -68,11 +69,11 @@ pub fn list(dirs: &Dirs, preset: &str) -> u8 {
         // Outside a checkout (no `problems/` here) `list` still shows the scenes; a folder
         // named with --problems that does not exist is a typo.
         Err(e) if !dirs.problems.exists() && dirs.problems == Path::new(DEFAULT_PROBLEMS) => {
-            println!("(no problems: {e})");
+            outln!("(no problems: {e})");
             OK
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             BAD_INPUT
         }
     }
@@ -104,22 +105,29 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
     let problems = match load(dirs, preset, only) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return BAD_INPUT;
         }
     };
     let mut status = OK;
     if !flags.plot_only {
-        let (tasks, done) = match runner::plan(&dirs.output, &problems, opts) {
+        let runner::Plan { tasks, done, damaged } = match runner::plan(&dirs.output, &problems, opts) {
             Ok(t) => t,
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!("error: {e}");
                 return BAD_INPUT;
             }
         };
+        // A damaged result is not a crash to rerun over: named, with the command that does.
+        for d in &damaged {
+            errln!("error: {d}");
+        }
+        if !damaged.is_empty() {
+            status = FAILED;
+        }
         if opts.dry_run {
             for t in &tasks {
-                println!(
+                outln!(
                     "would run {}/{} ({})  -> {}",
                     t.problem,
                     t.entry.case.name,
@@ -127,29 +135,29 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
                     t.entry.dir.display()
                 );
             }
-            println!("{} to run, {done} done (skipped)", tasks.len());
+            outln!("{} to run, {done} done (skipped)", tasks.len());
             return OK;
         }
         if let Err(e) = ensure_dir(&dirs.output, "output") {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return FAILED;
         }
-        println!("{} case(s) to run, {done} done (skipped)", tasks.len());
+        outln!("{} case(s) to run, {done} done (skipped)", tasks.len());
         let report = match runner::execute(tasks, opts) {
             Ok(r) => r,
             Err(e) => {
-                eprintln!("error: {e}");
+                errln!("error: {e}");
                 return FAILED;
             }
         };
         if report.interrupted {
-            eprintln!("interrupted: running cases were stopped and are not done");
+            errln!("interrupted: running cases were stopped and are not done");
             status = INTERRUPTED;
         }
         if !report.failures.is_empty() {
-            eprintln!("{} case(s) failed:", report.failures.len());
+            errln!("{} case(s) failed:", report.failures.len());
             for (case, log, why) in &report.failures {
-                eprintln!("  {case}: {why}\n    log: {}", log.display());
+                errln!("  {case}: {why}\n    log: {}", log.display());
             }
             if status == OK {
                 status = FAILED;
@@ -159,11 +167,11 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
             return status;
         }
     } else if opts.dry_run {
-        println!("(--plot-only: nothing would be simulated)");
+        outln!("(--plot-only: nothing would be simulated)");
         return OK;
     }
     if let Err(e) = post_process(dirs, &problems, flags) {
-        eprintln!("error: {e}");
+        errln!("error: {e}");
         return FAILED;
     }
     status
@@ -181,6 +189,24 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
         // Figures of nothing would overwrite the last ones drawn from results (a mistyped
         // --output, every case failed): leave them, and say so.
         let entries = super::cache::entries(&dirs.output, p);
+        // Nor are they drawn without a case whose result is damaged (it would be left out).
+        let damaged: Vec<String> = entries
+            .iter()
+            .filter_map(|e| match e.state() {
+                cache::State::Damaged(r) => Some(format!("{}/{}: {r}", p.name, e.case.name)),
+                _ => None,
+            })
+            .collect();
+        if !damaged.is_empty() {
+            // Without --plot-only the runner has named them already.
+            let named =
+                if flags.plot_only { format!("{}\n", damaged.join("\nerror: ")) } else { String::new() };
+            errors.push(format!(
+                "{named}{}: a case's result is damaged; its figures and tables are left as they were",
+                p.name
+            ));
+            continue;
+        }
         if !entries.is_empty() && !entries.iter().any(|e| e.is_done()) {
             errors.push(format!(
                 "{}: no case has a result under {}; its figures and tables are left as they were",
@@ -196,7 +222,7 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
                 continue;
             }
         }
-        println!(
+        outln!(
             "{}: {} figure(s), {} table(s) in {}",
             p.name,
             p.figures.len(),
@@ -225,7 +251,7 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
             },
             &path,
         )?;
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     Ok(())
 }
@@ -235,14 +261,14 @@ pub fn status(dirs: &Dirs, preset: &str, list_stale: bool) -> u8 {
     match load(dirs, preset, &[]) {
         Ok(ps) => {
             let n = check::status(&dirs.output, &ps, list_stale);
-            if n.failed + n.missing == 0 {
+            if n.failed + n.damaged + n.missing == 0 {
                 OK
             } else {
                 FAILED
             }
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             BAD_INPUT
         }
     }
@@ -253,15 +279,15 @@ pub fn check(dirs: &Dirs, preset: &str) -> u8 {
     let ps = match load(dirs, preset, &[]) {
         Ok(p) => p,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return BAD_INPUT;
         }
     };
     let (ok, bad) = check::check(&dirs.output, &ps);
     for b in &bad {
-        println!("FAIL {}: {}", b.case, b.what);
+        outln!("FAIL {}: {}", b.case, b.what);
     }
-    println!("{ok} bound(s) hold, {} breached (preset {preset})", bad.len());
+    outln!("{ok} bound(s) hold, {} breached (preset {preset})", bad.len());
     if bad.is_empty() {
         OK
     } else {

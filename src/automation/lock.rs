@@ -5,12 +5,14 @@
 //! The OS lock, not the pid, decides who holds it: the kernel releases it when the last
 //! process holding the file closes it, so a killed runner leaves nothing to clean up and a
 //! recycled pid cannot keep a case locked. The runner hands the open file to the
-//! simulation it starts (`inherit_fd`), so a simulation that outlives its runner still
-//! holds the case and no second one is started in the same folder.
+//! simulation it starts (`inherit_fd`, taken up there with [`Lock::adopt`]), so a
+//! simulation that outlives its runner still holds the case and no second one is started
+//! in the same folder. A `simulate` run on its own takes the lock of its output folder
+//! itself, so two of them never write into one folder.
 
 use std::fs::{File, OpenOptions, TryLockError};
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::{Component, Path, PathBuf};
 
 /// A held lock; released (and its file removed) on drop.
 #[derive(Debug)]
@@ -28,10 +30,35 @@ pub enum Try {
     Held(u32),
 }
 
+/// A lock on a folder held for this process by the runner that started it: the runner's
+/// open lock file, inherited ([`Lock::inherit_fd`]). The runner releases it.
+#[derive(Debug)]
+pub struct Inherited {
+    _file: File,
+}
+
+/// `dir` as an absolute path without `.` or `..` components or a trailing slash, so that
+/// every way of naming a folder (`out`, `./out/`, `x/../out`) finds the same lock file.
+/// Lexical: `..` after a symbolic link is taken as the parent of the link's own path.
+pub fn normalize(dir: &Path) -> PathBuf {
+    let abs = std::path::absolute(dir).unwrap_or_else(|_| dir.to_path_buf());
+    let mut out = PathBuf::new();
+    for c in abs.components() {
+        match c {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                out.pop();
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
 impl Lock {
     /// The lock file of a case folder.
     pub fn path_for(dir: &Path) -> PathBuf {
-        let mut s = dir.as_os_str().to_owned();
+        let mut s = normalize(dir).into_os_string();
         s.push(".lock");
         PathBuf::from(s)
     }
@@ -87,6 +114,31 @@ impl Lock {
     pub fn inherit_fd(&self) -> std::os::unix::io::RawFd {
         std::os::unix::io::AsRawFd::as_raw_fd(&self.file)
     }
+
+    /// Takes up the lock of `dir` that the runner which started this process holds and
+    /// handed down as the open descriptor `fd`: checked to be that folder's lock file, so
+    /// that a wrong number is an error, not a run without a lock.
+    #[cfg(unix)]
+    pub fn adopt(dir: &Path, fd: std::os::unix::io::RawFd) -> Result<Inherited, String> {
+        use std::os::unix::fs::MetadataExt;
+        use std::os::unix::io::FromRawFd;
+        let path = Self::path_for(dir);
+        // SAFETY: fcntl(F_GETFD) only asks whether the descriptor is open.
+        if fd < 0 || unsafe { libc::fcntl(fd, libc::F_GETFD) } < 0 {
+            return Err(format!("{}: the lock handed down (descriptor {fd}) is not open", path.display()));
+        }
+        // SAFETY: the descriptor is open and this process owns it from here on (the runner
+        // handed it down for this run only; nothing else in this process uses it).
+        let file = unsafe { File::from_raw_fd(fd) };
+        match (file.metadata(), std::fs::metadata(&path)) {
+            (Ok(a), Ok(b)) if a.dev() == b.dev() && a.ino() == b.ino() => Ok(Inherited { _file: file }),
+            _ => {
+                // Not ours to close: leave the descriptor as it was.
+                std::mem::forget(file);
+                Err(format!("{}: the lock handed down (descriptor {fd}) is another file", path.display()))
+            }
+        }
+    }
 }
 
 /// Whether `file` is the file now at `path` (same device and inode).
@@ -141,5 +193,22 @@ mod tests {
             assert_eq!(Lock::holder(&case), None);
             assert!(matches!(Lock::try_take(&case).unwrap(), Try::Taken(_)));
         }
+    }
+
+    /// Every name of one folder finds one lock file.
+    #[test]
+    fn every_name_of_a_folder_has_one_lock() {
+        let dir = tempfile::tempdir().unwrap();
+        let case = dir.path().join("case");
+        let lock = Lock::path_for(&case);
+        assert_eq!(lock, normalize(&dir.path().join("case.lock")));
+        for other in [dir.path().join("./case/"), dir.path().join("x/../case"), dir.path().join("case/.")] {
+            assert_eq!(Lock::path_for(&other), lock, "{other:?}");
+        }
+        let _held = match Lock::try_take(&case).unwrap() {
+            Try::Taken(l) => l,
+            t => panic!("{t:?}"),
+        };
+        assert!(matches!(Lock::try_take(&dir.path().join("x/../case/")).unwrap(), Try::Held(_)));
     }
 }

@@ -7,11 +7,12 @@
 use super::cache::{Entry, State};
 use super::lock::{Lock, Try};
 use super::registry::Problem;
+use crate::outln;
 use crate::scenes::harness::INTERRUPTED;
 use crate::scenes::progress::{duration, read_file};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::collections::VecDeque;
-use std::io::IsTerminal;
+use std::io::{BufRead, IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::sync::atomic::Ordering;
@@ -57,14 +58,27 @@ pub struct Report {
     pub interrupted: bool,
 }
 
-/// The cases of `problems` that must run, with the reason, and how many are done.
-pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<Task>, usize), String> {
+/// What a run of some problems has to do.
+#[derive(Debug, Default)]
+pub struct Plan {
+    /// The cases that must run, each with the reason.
+    pub tasks: Vec<Task>,
+    /// How many are done.
+    pub done: usize,
+    /// The cases whose result is damaged, each as `problem/case: what is wrong and the
+    /// command that computes it again`: not run unless forced.
+    pub damaged: Vec<String>,
+}
+
+/// The cases of `problems` that must run, with the reason, how many are done, and which
+/// are damaged.
+pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<Plan, String> {
     let matcher = match &opts.matching {
         Some(g) => Some(globset::Glob::new(g).map_err(|e| format!("--match `{g}`: {e}"))?.compile_matcher()),
         None => None,
     };
-    let mut tasks = Vec::new();
-    let (mut done, mut matched) = (0, 0);
+    let mut plan = Plan::default();
+    let mut matched = 0;
     for p in problems {
         for e in super::cache::entries(output, p) {
             if let Some(m) = &matcher {
@@ -76,7 +90,12 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
             let reason = match e.state() {
                 State::Done(_) if opts.force => "forced".to_string(),
                 State::Done(_) => {
-                    done += 1;
+                    plan.done += 1;
+                    continue;
+                }
+                State::Damaged(_) if opts.force => "forced over a damaged result".to_string(),
+                State::Damaged(r) => {
+                    plan.damaged.push(format!("{}/{}: {r}", p.name, e.case.name));
                     continue;
                 }
                 State::Failed(r) => match Lock::holder(&e.dir) {
@@ -86,14 +105,14 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<(Vec<
                 State::Missing(Some(change)) => format!("stale: {change}"),
                 State::Missing(None) => "missing".to_string(),
             };
-            tasks.push(Task { problem: p.name.clone(), entry: e, reason });
+            plan.tasks.push(Task { problem: p.name.clone(), entry: e, reason });
         }
     }
     // A pattern that selects nothing is a typo, not a request to run nothing.
     if let (Some(g), 0) = (&opts.matching, matched) {
         return Err(format!("--match `{g}`: no case of the selected problems matches it"));
     }
-    Ok((tasks, done))
+    Ok(plan)
 }
 
 /// Concurrent cases and rayon threads per case for `tasks` cases within a budget of
@@ -105,7 +124,7 @@ pub fn split_cores(jobs: Option<usize>, tasks: usize, threads: usize) -> (usize,
 
 /// Prints a line above the progress bars.
 fn say(mp: &MultiProgress, line: String) {
-    mp.suspend(|| println!("{line}"));
+    mp.suspend(|| outln!("{line}"));
 }
 
 /// Runs `tasks` in a job pool. Failures are collected, not fatal; Ctrl-C stops starting
@@ -220,15 +239,20 @@ fn run_one(
     if (waited || !force) && e.is_done() {
         return Outcome::Skipped("done by another runner".into());
     }
+    // Said before the folder is made: a runner that dies writing it (its stdout a closed
+    // pipe) leaves no folder that looks like a crashed case.
+    say(mp, format!("run     {name} ({})", task.reason));
     if let Err(err) = e.write_record() {
         return Outcome::Failed(err);
     }
-    say(mp, format!("run     {name} ({})", task.reason));
     let log_path = e.dir.join("run.log");
-    let log = match std::fs::OpenOptions::new().create(true).append(true).open(&log_path) {
+    let mut log = match std::fs::OpenOptions::new().create(true).append(true).open(&log_path) {
         Ok(f) => f,
         Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
     };
+    let started = chrono::Utc::now().to_rfc3339_opts(chrono::SecondsFormat::Secs, true);
+    // The log of a case run more than once (interrupted, resumed) tells its attempts apart.
+    let mut log_error = writeln!(log, "== {started} run ({})", task.reason).err();
     let progress = e.dir.join("progress");
     let _ = std::fs::remove_file(&progress);
     let mut cmd = Command::new(exe);
@@ -250,18 +274,44 @@ fn run_one(
     if let Some(c) = checkpoint {
         cmd.arg("--checkpoint-every").arg(c.to_string());
     }
-    let log2 = match log.try_clone() {
+    let stdout = match log.try_clone() {
         Ok(l) => l,
         Err(err) => return Outcome::Failed(format!("{}: {err}", log_path.display())),
     };
-    cmd.stdout(Stdio::from(log)).stderr(Stdio::from(log2));
+    // The case's messages come through this runner on their way to the log, so that one it
+    // cannot write there (a full disk) still reaches the report.
+    cmd.stdout(Stdio::from(stdout)).stderr(Stdio::piped());
     #[cfg(unix)]
-    bind_to_runner(&mut cmd, lock.inherit_fd());
+    {
+        cmd.arg("--lock-fd").arg(lock.inherit_fd().to_string());
+        bind_to_runner(&mut cmd, lock.inherit_fd());
+    }
     let t0 = Instant::now();
     let mut child = match cmd.spawn() {
         Ok(c) => c,
         Err(err) => return Outcome::Failed(format!("cannot start {}: {err}", exe.display())),
     };
+    let stderr = child.stderr.take().expect("piped");
+    let copier = std::thread::spawn({
+        let mut log = log.try_clone();
+        move || {
+            // (last line, first error writing the log)
+            let (mut last, mut error) = (String::new(), None);
+            for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+                let written = match log.as_mut() {
+                    Ok(l) => writeln!(l, "{line}"),
+                    Err(e) => Err(std::io::Error::new(e.kind(), e.to_string())),
+                };
+                if let Err(e) = written {
+                    error.get_or_insert(e);
+                }
+                if !line.trim().is_empty() {
+                    last = line;
+                }
+            }
+            (last, error)
+        }
+    });
     let bar = mp.add(ProgressBar::new(1000));
     bar.set_style(
         ProgressStyle::with_template("{prefix:>12} [{elapsed_precise}] {bar:30} {msg}").expect("template"),
@@ -290,21 +340,45 @@ fn run_one(
     mp.remove(&bar);
     let _ = std::fs::remove_file(&progress);
     let secs = t0.elapsed().as_secs_f64();
+    let (last, copy_error) = copier.join().unwrap_or_default();
+    log_error = log_error.or(copy_error);
     let code = match status {
         Ok(s) => s,
         Err(err) => return Outcome::Failed(format!("waiting for the case: {err}")),
     };
-    match e.state() {
+    let outcome = match e.state() {
         State::Done(s) => Outcome::Done(
             secs,
             serde_json::to_value(s).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
         ),
         // `simulate` exits 2 on bad input, having written its one-line error and nothing else.
-        State::Failed(_) if code.code() == Some(2) => {
-            Outcome::Failed(format!("bad input: {}", last_error(&e.dir.join("run.log"))))
+        State::Failed(_) | State::Missing(_) if code.code() == Some(2) => {
+            Outcome::Failed(format!("bad input: {}", last.strip_prefix("error: ").unwrap_or(&last)))
+        }
+        // It said why it failed, but could not write a summary (a full disk, say).
+        State::Failed(_) | State::Missing(_) | State::Damaged(_)
+            if code.code() == Some(1) && last.starts_with("failed: ") =>
+        {
+            Outcome::Failed(format!("{} ({code})", &last["failed: ".len()..]))
         }
         State::Failed(r) => Outcome::Failed(format!("{r} ({code})")),
+        State::Damaged(r) => Outcome::Failed(format!("{r} ({code})")),
         State::Missing(_) => Outcome::Failed(format!("no result ({code})")),
+    };
+    // The log ends with how this attempt ended (a resumed case's with its completion).
+    let end = match &outcome {
+        Outcome::Done(secs, how) => format!("== {how} ({secs:.1} s)"),
+        Outcome::Failed(why) => format!("== failed: {why}"),
+        Outcome::Skipped(why) => format!("== skipped: {why}"),
+    };
+    if let Err(err) = writeln!(log, "{end}").and_then(|()| log.flush()) {
+        log_error.get_or_insert(err);
+    }
+    match (outcome, log_error) {
+        (Outcome::Failed(why), Some(err)) => {
+            Outcome::Failed(format!("{why}; its log could not be written: {}: {err}", log_path.display()))
+        }
+        (outcome, _) => outcome,
     }
 }
 
@@ -340,13 +414,6 @@ fn bind_to_runner(cmd: &mut Command, lock_fd: std::os::unix::io::RawFd) {
             Ok(())
         });
     }
-}
-
-/// The last `error: ...` line of a case's log, without the prefix.
-fn last_error(log: &std::path::Path) -> String {
-    let text = std::fs::read_to_string(log).unwrap_or_default();
-    let line = text.lines().rev().find_map(|l| l.strip_prefix("error: "));
-    line.unwrap_or("see the log").to_string()
 }
 
 fn short(s: &str, n: usize) -> String {

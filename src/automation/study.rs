@@ -71,9 +71,8 @@ fn fmt(x: f64) -> String {
 /// result, which the error says how to compute again.
 fn timeseries(p: &Problem, r: &Run, y: &str) -> Result<(Vec<f64>, Vec<f64>), String> {
     columns(&r.entry.dir.join("timeseries.csv"), "t", y).map_err(|e| {
-        let preset = if p.preset == "quick" { String::new() } else { format!(" --preset {}", p.preset) };
-        let (problem, case) = (&p.name, &r.case.name);
-        format!("{e} (a damaged result: `sphrepro run {problem}{preset} --match {case} --force` computes it again)")
+        let command = super::cache::recompute_command(&p.name, &p.preset, &r.case.name);
+        format!("{e} (a damaged result: {command} computes it again)")
     })
 }
 

@@ -106,11 +106,11 @@ pub fn interleaved_child(
 fn print_json(r: Result<impl serde::Serialize, String>) -> u8 {
     match r {
         Ok(r) => {
-            println!("{}", serde_json::to_string(&r).expect("serialises"));
+            crate::outln!("{}", serde_json::to_string(&r).expect("serialises"));
             0
         }
         Err(e) => {
-            eprintln!("error: {e}");
+            crate::errln!("error: {e}");
             1
         }
     }

@@ -141,8 +141,8 @@ pub(super) fn print(
     peers: &[PeerResult],
     targets: &[TargetRow],
 ) {
-    println!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", machine.describe());
-    println!("{}", table(results, peers));
+    crate::outln!("Taylor-Green, Re = 100, kernel {kernel}, h/dx = 1, on {}:\n", machine.describe());
+    crate::outln!("{}", table(results, peers));
     if !targets.is_empty() {
         // The targets are set for the peer's own run, with its (and the paper's) kernel.
         let caveat = if kernel == DEFAULT_KERNEL {
@@ -150,7 +150,7 @@ pub(super) fn print(
         } else {
             format!(" (they are set for the {DEFAULT_KERNEL} kernel; this run used {kernel})")
         };
-        println!("Against the throughput targets{caveat}:\n\n{}", targets::table(targets));
+        crate::outln!("Against the throughput targets{caveat}:\n\n{}", targets::table(targets));
     }
 }
 

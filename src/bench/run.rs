@@ -54,7 +54,7 @@ pub fn run(o: &Options) -> u8 {
     let variants = match check(o) {
         Ok(v) => v,
         Err(e) => {
-            eprintln!("error: bench: {e}");
+            crate::errln!("error: bench: {e}");
             return 2;
         }
     };
@@ -82,13 +82,15 @@ pub fn run(o: &Options) -> u8 {
     )
     .expect("serialises");
     if let Err(e) = write_json(&o.json, &text) {
-        eprintln!("error: {e}");
+        crate::errln!("error: {e}");
         return 1;
     }
-    eprintln!("wrote {}", o.json.display());
+    crate::errln!("wrote {}", o.json.display());
     match failure {
         Some(e) => {
-            eprintln!("error: the bench stopped early (the table and the JSON hold what ran before): {e}");
+            crate::errln!(
+                "error: the bench stopped early (the table and the JSON hold what ran before): {e}"
+            );
             1
         }
         None => 0,
@@ -122,7 +124,7 @@ fn side_by_side(exe: &Path, o: &Options, variants: &[String], rounds: u32, m: &m
     let threads = &o.threads;
     for &n in &o.nx {
         let k = o.steps.unwrap_or_else(|| default_steps(n * n));
-        eprint!(
+        crate::err!(
             "bench nx={n}, {} on {threads:?} threads side by side, {rounds} rounds of {} steps each ... ",
             variants.join(", "),
             k.div_ceil(rounds as u64)
@@ -140,11 +142,11 @@ fn side_by_side(exe: &Path, o: &Options, variants: &[String], rounds: u32, m: &m
                         )
                     })
                     .collect();
-                eprintln!("{}", speeds.join(", "));
+                crate::errln!("{}", speeds.join(", "));
                 m.results.extend(r);
             }
             Err(e) => {
-                eprintln!("{e}");
+                crate::errln!("{e}");
                 m.failure = Some(format!("bench nx={n}, side by side: {e}"));
                 return;
             }
@@ -163,14 +165,14 @@ fn in_rounds(exe: &Path, o: &Options, variants: &[String], m: &mut Measured) {
             for v in variants {
                 for &t in &o.threads {
                     let k = o.steps.unwrap_or_else(|| default_steps(n * n));
-                    eprint!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
+                    crate::err!("bench {v} nx={n} threads={t} steps={k}{of} ... ");
                     match bench_case(exe, v, n, t, k, &o.kernel) {
                         Ok(r) => {
-                            eprintln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
+                            crate::errln!("{:.3} M particle-steps/s", r.particle_steps_per_second / 1e6);
                             m.results.push(r);
                         }
                         Err(e) => {
-                            eprintln!("{e}");
+                            crate::errln!("{e}");
                             m.failure = Some(format!("bench {v} nx={n} threads={t}: {e}"));
                             return;
                         }
@@ -182,14 +184,14 @@ fn in_rounds(exe: &Path, o: &Options, variants: &[String], m: &mut Measured) {
             for &n in &o.nx {
                 for &t in &o.threads {
                     let tf = peer_tf(n);
-                    eprint!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
+                    crate::err!("peer {} nx={n} threads={t} tf={tf:.4}{of} ... ", script.display());
                     match peer_run(script, n, t, tf) {
                         Ok(p) => {
-                            eprintln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
+                            crate::errln!("{:.3} M particle-steps/s", p.particle_steps_per_second / 1e6);
                             m.peers.push(p);
                         }
                         Err(e) => {
-                            eprintln!("error: peer {}: {e}", script.display());
+                            crate::errln!("error: peer {}: {e}", script.display());
                             m.failure = Some(format!("peer {} nx={n} threads={t}: {e}", script.display()));
                             return;
                         }
@@ -204,16 +206,16 @@ fn in_rounds(exe: &Path, o: &Options, variants: &[String], m: &mut Measured) {
 /// set in `p`; an error names the run.
 fn peer_accuracy(exe: &Path, p: &mut PeerResult, kernel: &str) -> Result<(), String> {
     let (n, t) = (p.nx, p.threads);
-    eprint!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
+    crate::err!("edac nx={n} threads={t} to the peer's t = {:.4} ... ", p.end_time());
     match edac_l1(exe, n, t, p.end_time(), kernel) {
         Ok(l1) => {
             p.sphrepro_l1_velocity_final = Some(l1);
             let peer = p.l1_velocity_final.map_or("-".into(), |v| format!("{:.2} %", 100.0 * v));
-            eprintln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
+            crate::errln!("L1: peer {peer}, edac {:.2} %", 100.0 * l1);
             Ok(())
         }
         Err(e) => {
-            eprintln!("\nerror: edac on the peer's run: {e}");
+            crate::errln!("\nerror: edac on the peer's run: {e}");
             Err(format!("edac on the peer's run nx={n} threads={t}: {e}"))
         }
     }

@@ -55,7 +55,10 @@ pub fn scheme_params(default_pst: &str) -> Vec<Spec> {
             Bound::Positive,
             "IPST tolerance on |max chi - chi_ref| / chi_ref, eq. (39)",
         ),
-        Spec::int("ipst_max_iter", paper::IPST_MAX_ITER as i64, 1, "IPST iterations per step at most"),
+        // Bounded: a step's sweeps do not see Ctrl-C, and a tolerance no sweep meets would
+        // otherwise make one step last forever.
+        Spec::int("ipst_max_iter", paper::IPST_MAX_ITER as i64, 1, "IPST iterations per step at most")
+            .at_most(1000.0),
         Spec::int(
             "ipst_interval",
             paper::IPST_INTERVAL as i64,
@@ -242,8 +245,9 @@ fn check_step_count(scene: &str, p: &Params, h: f64, c: &FluidConstants) -> Resu
     let steps = tf / dt;
     if steps > MAX_STEPS {
         return Err(format!(
-            "scene `{scene}`: `tf` = {tf} s needs {steps:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit), more than {MAX_STEPS:.0e}: check {}",
+            "scene `{scene}`: `tf` = {tf} s needs {steps:.1e} steps at the time step of eq. (61), {dt:.3e} s (its {} limit at `cfl` = {}), more than {MAX_STEPS:.0e}: check {}",
             limit.name(),
+            p.float("cfl"),
             match limit {
                 TimeStepLimit::Viscous => "the viscosity (re)",
                 TimeStepLimit::BodyForce => "gravity",
@@ -355,14 +359,37 @@ pub fn check_size<const D: usize>(
 const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
 
 /// The memory this process may use in bytes, if the system says (Linux): the machine's
-/// physical memory, or a container's limit (cgroup v2) if lower.
+/// physical memory, or a container's limit (cgroup v2) if lower, or what its address-space
+/// limit (`ulimit -v`) leaves beyond the address space it already holds, if lower still (an
+/// allocation past that limit aborts the process, with no summary).
 fn total_memory() -> Option<f64> {
     let info = std::fs::read_to_string("/proc/meminfo").ok()?;
     let line = info.lines().find(|l| l.starts_with("MemTotal:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
     let limit =
         std::fs::read_to_string("/sys/fs/cgroup/memory.max").ok().and_then(|s| s.trim().parse::<f64>().ok());
-    Some(limit.map_or(kib * 1024.0, |l| l.min(kib * 1024.0)))
+    let have = limit.map_or(kib * 1024.0, |l| l.min(kib * 1024.0));
+    Some(address_space_left().map_or(have, |left| left.min(have)))
+}
+
+/// Bytes of address space left under the process's limit (`RLIMIT_AS`), if it has one.
+#[cfg(target_os = "linux")]
+fn address_space_left() -> Option<f64> {
+    let mut limit = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+    // SAFETY: getrlimit writes into the struct it is given.
+    if unsafe { libc::getrlimit(libc::RLIMIT_AS, &mut limit) } != 0 || limit.rlim_cur == libc::RLIM_INFINITY {
+        return None;
+    }
+    // VmSize: the address space the process holds now, in kiB.
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmSize:"))?;
+    let held: f64 = line.split_whitespace().nth(1)?.parse::<f64>().ok()? * 1024.0;
+    Some((limit.rlim_cur as f64 - held).max(0.0))
+}
+
+#[cfg(not(target_os = "linux"))]
+fn address_space_left() -> Option<f64> {
+    None
 }
 
 /// A `D`-vector as the three components ParaView reads (zeros beyond `D`).

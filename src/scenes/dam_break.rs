@@ -106,7 +106,7 @@ fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), Strin
     if th < hc {
         return bad("tank_height", format!("the tank is lower than the column (column_height = {hc})"));
     }
-    column(p).setup("dam_break", ["column_width", "column_height"], p)
+    column(p).setup("dam_break", ["column_width", "column_height", "tank_width", "tank_height"], p)
 }
 
 /// The water column in its tank.

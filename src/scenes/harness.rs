@@ -3,8 +3,10 @@
 use super::progress::Progress;
 use super::{params::Params, SceneEntry, SceneRun};
 
+use crate::errln;
 use crate::solver::output::summary::{Provenance, Status, Summary};
 use crate::solver::output::vtu::Series;
+use crate::solver::simulation::Divergence;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -68,11 +70,85 @@ fn io_err(path: &Path, e: std::io::Error) -> String {
     format!("{}: {e}", path.display())
 }
 
+/// The time resolution of a run to `tf`: times closer than this count as equal (the
+/// solver's step loop takes the same), 1e-12 of `tf` or of 1 s, whichever is larger.
+pub fn time_resolution(tf: f64) -> f64 {
+    1e-12 * tf.max(1.0)
+}
+
+/// Refuses times a run cannot resolve in double precision: an end time `tf` no longer than
+/// the time resolution (no step would be taken), and an `output_dt` or `sample_dt` given
+/// shorter than it (outputs that close cannot be told apart). Each error names the key.
+pub fn check_times(scene: &str, p: &Params) -> Result<(), String> {
+    let tf = p.float("tf");
+    let resolution = time_resolution(tf);
+    if tf <= resolution {
+        return Err(format!(
+            "scene `{scene}`: `tf` = {tf:e}: not longer than the time resolution of a run, {resolution:e} s (no step would be taken)"
+        ));
+    }
+    for key in ["output_dt", "sample_dt"] {
+        let dt = p.float(key);
+        if dt > 0.0 && dt <= resolution {
+            return Err(format!(
+                "scene `{scene}`: `{key}` = {dt:e}: not longer than the time resolution of this run, {resolution:e} s (1e-12 of `tf` or of 1 s); 0 takes a tenth (output) or a hundredth (samples) of `tf`"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The first multiple of `interval` later than `t` by more than `eps`: the next output or
+/// sample time after a step that ended at `t`, computed at once (adding `interval` until
+/// it passes would spin for as many intervals as `eps` holds). Always later than `t + eps`,
+/// so that the run steps before it comes: an interval too fine to pass it (the default
+/// tf/100 of a tiny `tf`) gives one output a step.
+fn next_after(t: f64, eps: f64, interval: f64) -> f64 {
+    let k = ((t + eps) / interval).floor() + 1.0;
+    let mut next = k * interval;
+    // The product may round down onto `t + eps`.
+    if next - eps <= t {
+        next = (k + 1.0) * interval;
+    }
+    if next - eps <= t {
+        next = t + 2.0 * eps;
+    }
+    next
+}
+
+/// The first value of `row` (a time-series row or the metrics) that is not finite, as
+/// `(name, value)`.
+fn not_finite<'a>(row: impl IntoIterator<Item = (&'a str, f64)>) -> Option<(&'a str, f64)> {
+    row.into_iter().find(|(_, v)| !v.is_finite())
+}
+
+/// Removes the snapshots an earlier run left in `out` (its `.pvd` series and their `vtu/`
+/// files), so that a run started afresh there lists what the folder holds.
+fn remove_old_snapshots(out: &Path, vtu_dir: &Path) -> std::io::Result<()> {
+    for e in std::fs::read_dir(vtu_dir)? {
+        let path = e?.path();
+        if path.extension().is_some_and(|x| x == "vtu") {
+            std::fs::remove_file(&path)?;
+        }
+    }
+    for e in std::fs::read_dir(out)? {
+        let path = e?.path();
+        // A series of ours: a `.pvd` whose snapshots are under `vtu/`.
+        if path.extension().is_some_and(|x| x == "pvd")
+            && std::fs::read_to_string(&path).is_ok_and(|s| s.contains("file=\"vtu/"))
+        {
+            std::fs::remove_file(&path)?;
+        }
+    }
+    Ok(())
+}
+
 /// Runs `entry` with `params`, writing into `out`. Returns the summary (completed or
 /// diverged), or an error.
 pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -> Result<Summary, RunError> {
     let started = chrono::Utc::now();
     let t0 = Instant::now();
+    check_times(entry.name, params).map_err(RunError::Input)?;
     // Refuse to overwrite a finished result unless asked.
     if let Ok(old) = Summary::read(out) {
         if old.status != Status::Failed && !opts.force {
@@ -117,7 +193,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     };
     let plan = scene.plan();
     if !opts.quiet {
-        eprintln!("{} with {} particles\n{plan}", entry.name, scene.particles());
+        errln!("{} with {} particles\n{plan}", entry.name, scene.particles());
     }
     let _ = std::fs::write(out.join("plan.txt"), &plan);
 
@@ -144,11 +220,12 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 series.insert(body, Series::with_entries(pvd, entries));
             }
             if !opts.quiet {
-                eprintln!("resuming from {} at t = {}", ckpt_path.display(), scene.time());
+                errln!("resuming from {} at t = {}", ckpt_path.display(), scene.time());
             }
         }
         None => {
             let _ = std::fs::remove_file(&ckpt_path);
+            remove_old_snapshots(out, &vtu_dir).map_err(|e| RunError::Input(io_err(out, e)))?;
             std::fs::File::create(&ts_path).map_err(|e| RunError::Input(io_err(&ts_path, e)))?;
         }
     }
@@ -163,7 +240,14 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     let particles = scene.particles() as f64;
     // The particle-steps per second of the stepping so far, shown after each output.
     let mut rate = String::new();
-    let eps = 1e-12 * tf.max(1.0);
+    let eps = time_resolution(tf);
+    // The state the run stopped in, as the last snapshot of the series: what blew up and
+    // where, for ParaView. Best effort: the divergence is the result.
+    let last_snapshot = |scene: &dyn SceneRun, index: usize, series: &mut BTreeMap<String, Series>| {
+        if let Err(e) = snapshot(scene, out, &vtu_dir, index, series) {
+            errln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
+        }
+    };
     let outcome = loop {
         let t = scene.time();
         let at_end = t >= tf - eps;
@@ -190,21 +274,29 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
                 break Outcome::Failed(format!("{}: {e}", ts_path.display()));
             }
             ts_rows += 1;
-            while next_sample <= t + eps {
-                next_sample += sample_dt;
+            // A value that is not finite is a blow-up the solver's checks of the fields did
+            // not see (a norm over particles that all sit at one point, say).
+            if let Some((k, v)) = not_finite(row.iter().copied()) {
+                last_snapshot(scene.as_ref(), snapshot_index, &mut series);
+                let reason = format!("time-series value `{k}` = {v} is not finite");
+                break Outcome::Diverged(Divergence { reason, step: scene.steps(), time: t });
             }
+            next_sample = next_after(t, eps, sample_dt);
         }
         if t >= next_output - eps || at_end {
             if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
                 break Outcome::Failed(io_err(&vtu_dir, e));
             }
             snapshot_index += 1;
-            while next_output <= t + eps {
-                next_output += output_dt;
-            }
+            next_output = next_after(t, eps, output_dt);
         }
         if at_end {
-            break Outcome::Completed;
+            let metrics = scene.metrics();
+            if let Some((k, v)) = not_finite(metrics.iter().map(|(k, v)| (k.as_str(), *v))) {
+                let reason = format!("metric `{k}` = {v} is not finite at the end of the run");
+                break Outcome::Diverged(Divergence { reason, step: scene.steps(), time: t });
+            }
+            break Outcome::Completed(metrics);
         }
         // Output happens at the first step boundary at or after each output time: steps
         // are never shortened for output, so the cadence does not change the solution.
@@ -212,7 +304,9 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let ts0 = Instant::now();
         let res = scene.advance(target, tf, &mut |time, steps| {
             progress.update(time, steps, &rate);
-            !INTERRUPTED.load(Ordering::Relaxed) && opts.stop_after_steps.is_none_or(|n| steps < n)
+            !INTERRUPTED.load(Ordering::Relaxed)
+                && crate::console::failure().is_none()
+                && opts.stop_after_steps.is_none_or(|n| steps < n)
         });
         stepping += ts0.elapsed().as_secs_f64();
         rate = format!("{:.3e} particle-steps/s", particles * scene.steps() as f64 / stepping.max(1e-9));
@@ -220,11 +314,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         let reached = match res {
             Ok(reached) => reached,
             Err(d) => {
-                // The state the check stopped, as the last snapshot of the series: what blew
-                // up and where, for ParaView. Best effort: the divergence is the result.
-                if let Err(e) = snapshot(scene.as_ref(), out, &vtu_dir, snapshot_index, &mut series) {
-                    eprintln!("warning: no snapshot of the diverged state: {}", io_err(&vtu_dir, e));
-                }
+                last_snapshot(scene.as_ref(), snapshot_index, &mut series);
                 break Outcome::Diverged(d);
             }
         };
@@ -248,14 +338,14 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
             last_checkpoint = Instant::now();
         }
         if !reached {
-            break Outcome::Failed(
-                "interrupted (checkpoint written: the next run of this case resumes)".into(),
-            );
+            // Stopped by a signal, or by a message that could not be written.
+            let why = crate::console::failure().unwrap_or_else(|| "interrupted".into());
+            break Outcome::Failed(format!("{why} (checkpoint written: the next run of this case resumes)"));
         }
     };
     progress.finish();
     let (status, reason, metrics) = match &outcome {
-        Outcome::Completed => (Status::Completed, None, scene.metrics()),
+        Outcome::Completed(m) => (Status::Completed, None, m.clone()),
         Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), BTreeMap::new()),
         Outcome::Failed(r) => (Status::Failed, Some(r.clone()), BTreeMap::new()),
     };
@@ -294,8 +384,9 @@ fn snapshot(
 }
 
 enum Outcome {
-    Completed,
-    Diverged(crate::solver::simulation::Divergence),
+    /// Reached `tf`, with these metrics, every one finite.
+    Completed(BTreeMap<String, f64>),
+    Diverged(Divergence),
     Failed(String),
 }
 
@@ -379,6 +470,42 @@ fn truncate_rows(path: &Path, rows: usize) -> std::io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The next output time comes at once however small the interval is against the time
+    /// resolution, and is the first multiple of the interval past it.
+    #[test]
+    fn the_next_output_time_is_computed_not_counted_up_to() {
+        assert_eq!(next_after(0.0, 1e-12, 0.1), 0.1);
+        assert_eq!(next_after(0.1, 1e-12, 0.1), 0.2);
+        assert_eq!(next_after(0.25, 1e-12, 0.1), 0.30000000000000004);
+        // 1e290 intervals within the resolution: one multiplication, not 1e290 additions.
+        let t = std::time::Instant::now();
+        let next = next_after(0.0, 1e-12, 1e-302);
+        assert!(next > 1e-12 && next <= 2e-12, "{next:e}");
+        assert!(t.elapsed().as_secs_f64() < 0.1);
+        // Always past the resolution, so that a step comes before it.
+        for (t, interval) in [(0.0, 1e-12), (1.0, 1e-13), (0.3, 3e-13), (1e3, 1e-20)] {
+            let eps = time_resolution(t);
+            assert!(next_after(t, eps, interval) - eps > t, "{t} {interval}");
+        }
+        // An interval longer than the run: its end.
+        assert_eq!(next_after(0.5, 1e-12, 1e300), 1e300);
+    }
+
+    #[test]
+    fn times_a_run_cannot_resolve_are_refused_naming_the_key() {
+        let specs = crate::scenes::common_params(2.0);
+        let with = |k: &str, v: f64| {
+            let mut p = Params::defaults(&specs);
+            p.0.insert(k.into(), super::super::params::Value::Float(v));
+            check_times("s", &p)
+        };
+        assert!(with("tf", 2.0).is_ok() && with("output_dt", 2e-12 * 1.5).is_ok());
+        for (k, v) in [("tf", 1e-300), ("tf", 1e-12), ("output_dt", 1e-15), ("sample_dt", 2e-12)] {
+            let e = with(k, v).unwrap_err();
+            assert!(e.contains(&format!("`{k}` = {v:e}")), "{e}");
+        }
+    }
 
     /// Rows written by an older build keep their values under their column names; a column
     /// new to this build reads NaN, one it no longer samples is dropped.

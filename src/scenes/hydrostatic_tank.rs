@@ -78,7 +78,7 @@ fn setup(p: &Params) -> Result<(FluidConstants, Kernel, f64, FluidScheme), Strin
             "scene `hydrostatic_tank`: `tank_acceleration` = {a}: a tank falling at g = {G} m/s^2 or faster cannot hold its water"
         ));
     }
-    column(p).setup("hydrostatic_tank", ["width", "height"], p)
+    column(p).setup("hydrostatic_tank", ["width", "height", "width", "height"], p)
 }
 
 /// The fluid column in a tank as wide and half as high again.

@@ -75,20 +75,38 @@ pub struct Spec {
     /// Added after results were computed without it, with a default that reproduces them:
     /// at its default it stays out of the cache key, so those results stay current.
     pub added_later: bool,
+    /// The largest value that makes sense, if there is one (a number or an integer): a
+    /// perturbation beyond the spacing, or a loop bound so large that a step would never
+    /// end, is refused up front with the key named.
+    pub max: Option<f64>,
 }
 
 impl Spec {
     /// An integer parameter.
     pub fn int(name: &'static str, default: i64, min: i64, help: &'static str) -> Self {
-        Self { name, kind: Kind::Int { min }, default: Value::Int(default), help, added_later: false }
+        Self {
+            name,
+            kind: Kind::Int { min },
+            default: Value::Int(default),
+            help,
+            added_later: false,
+            max: None,
+        }
     }
     /// A float parameter.
     pub fn float(name: &'static str, default: f64, bound: Bound, help: &'static str) -> Self {
-        Self { name, kind: Kind::Float { bound }, default: Value::Float(default), help, added_later: false }
+        Self {
+            name,
+            kind: Kind::Float { bound },
+            default: Value::Float(default),
+            help,
+            added_later: false,
+            max: None,
+        }
     }
     /// A boolean parameter.
     pub fn bool(name: &'static str, default: bool, help: &'static str) -> Self {
-        Self { name, kind: Kind::Bool, default: Value::Bool(default), help, added_later: false }
+        Self { name, kind: Kind::Bool, default: Value::Bool(default), help, added_later: false, max: None }
     }
     /// A choice parameter.
     pub fn choice(
@@ -103,6 +121,7 @@ impl Spec {
             default: Value::Str(default.into()),
             help,
             added_later: false,
+            max: None,
         }
     }
 
@@ -111,8 +130,21 @@ impl Spec {
         Self { added_later: true, ..self }
     }
 
+    /// The parameter with its largest sensible value, [`max`](Self::max).
+    pub fn at_most(self, max: f64) -> Self {
+        Self { max: Some(max), ..self }
+    }
+
     /// The kind in words, for help and errors.
     pub fn kind_name(&self) -> String {
+        let kind = self.lower_bound_name();
+        match self.max {
+            Some(max) => format!("{kind}, <= {max}"),
+            None => kind,
+        }
+    }
+
+    fn lower_bound_name(&self) -> String {
         match self.kind {
             Kind::Int { min } => format!("integer >= {min}"),
             Kind::Float { bound: Bound::Positive } => "number > 0".into(),
@@ -125,11 +157,19 @@ impl Spec {
 
     /// Checks a typed value (from a problem file), converting an integer given for a float.
     pub fn check(&self, scene: &str, v: &Value) -> Result<Value, String> {
-        let bad = |why: &str| format!("scene `{scene}`: parameter `{}` = {v}: {why}", self.name);
+        // A number as Rust reads it back: 1e300 in three digits, not in 301.
+        let shown = match v {
+            Value::Float(x) => format!("{x:?}"),
+            v => v.to_string(),
+        };
+        let bad = |why: &str| format!("scene `{scene}`: parameter `{}` = {shown}: {why}", self.name);
         match (self.kind, v) {
             (Kind::Int { min }, Value::Int(i)) => {
                 if *i < min {
                     return Err(bad(&format!("must be >= {min}")));
+                }
+                if let Some(max) = self.max.filter(|&m| *i as f64 > m) {
+                    return Err(bad(&format!("must be <= {max}")));
                 }
                 Ok(v.clone())
             }
@@ -146,6 +186,9 @@ impl Spec {
                 match bound {
                     Bound::Positive if x <= 0.0 => Err(bad("must be > 0")),
                     Bound::NonNegative if x < 0.0 => Err(bad("must be >= 0")),
+                    _ if self.max.is_some_and(|m| x > m) => {
+                        Err(bad(&format!("must be <= {}", self.max.unwrap_or_default())))
+                    }
                     _ => Ok(Value::Float(x)),
                 }
             }
@@ -274,6 +317,8 @@ mod tests {
             Spec::float("tf", 2.0, Bound::Positive, "end time"),
             Spec::bool("flag", true, "a switch"),
             Spec::choice("scheme", &["edac", "ctvf"], "ctvf", "scheme"),
+            Spec::float("perturb", 0.0, Bound::NonNegative, "a displacement").at_most(1.0),
+            Spec::int("sweeps", 10, 1, "a loop bound").at_most(1000.0),
         ]
     }
 
@@ -293,6 +338,13 @@ mod tests {
         assert!(e.contains("warp9") && e.contains("edac, ctvf"), "{e}");
         let e = p.set_str("tg", &s, "tf", "nan").unwrap_err();
         assert!(e.contains("finite"), "{e}");
+        let e = p.set_str("tg", &s, "perturb", "1e20").unwrap_err();
+        assert!(e.contains("`perturb` = 1e20: must be <= 1"), "{e}");
+        let e = p.set_str("tg", &s, "sweeps", "1001").unwrap_err();
+        assert!(e.contains("`sweeps` = 1001: must be <= 1000"), "{e}");
+        p.set_str("tg", &s, "perturb", "1").unwrap();
+        p.set_str("tg", &s, "sweeps", "1000").unwrap();
+        assert_eq!(s[4].kind_name(), "number >= 0, <= 1");
     }
 
     #[test]

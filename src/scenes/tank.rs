@@ -39,16 +39,16 @@ impl Column {
     /// The constants, kernel, smoothing length and scheme of scene `scene`, once the checks
     /// every tank makes have passed (after the scene's own checks of its geometry): a
     /// column at least four particles wide and high (`keys` name its width and height
-    /// among the parameters `p`), a free-surface scheme, a size that fits, enough wall
-    /// layers for the kernel.
+    /// among the parameters `p`, then the parameters the tank's size comes from), a
+    /// free-surface scheme, a size that fits, enough wall layers for the kernel.
     pub fn setup(
         &self,
         scene: &str,
-        keys: [&str; 2],
+        keys: [&str; 4],
         p: &Params,
     ) -> Result<(FluidConstants, Kernel, f64, FluidScheme), String> {
         let Self { width, height, tank: (tw, th), dx } = *self;
-        let [width_key, height_key] = keys;
+        let [width_key, height_key, ..] = keys;
         for (key, len) in [(height_key, height), (width_key, width)] {
             if len < 4.0 * dx {
                 return Err(format!(
@@ -58,7 +58,16 @@ impl Column {
         }
         require_free_surface_scheme(scene, p)?;
         let walls = (tw + 2.0 * th) / dx * LAYERS as f64;
-        check_size::<2>(scene, "dx", dx, (width / dx) * (height / dx) + walls)?;
+        // Named with the lengths the count comes from: any of them may be the one that is off.
+        let mut lengths: Vec<String> = Vec::new();
+        for key in keys.iter().filter(|k| p.0.contains_key(**k)) {
+            let named = format!("`{key}` = {}", p.float(key));
+            if !lengths.contains(&named) {
+                lengths.push(named);
+            }
+        }
+        let size = format!("{dx} ({})", lengths.join(", "));
+        check_size::<2>(scene, "dx", size, (width / dx) * (height / dx) + walls)?;
         let constants = FluidConstants::under_gravity(RHO0, G, height, dx, p.float("alpha"));
         let (kernel, h, scheme) = fluid_scheme::<2>(scene, p, &constants)?;
         check_wall_layers(scene, p, &kernel, h, dx, LAYERS)?;

@@ -93,7 +93,9 @@ fn params<const D: usize>() -> Vec<Spec> {
     let mut v = vec![
         Spec::int("nx", 50, 1, "particles per side"),
         Spec::float("re", 100.0, Bound::Positive, "Reynolds number U L / nu"),
-        Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx"),
+        // At most dx / 2 each way: a particle never passes its neighbour's lattice site.
+        Spec::float("perturb", 0.0, Bound::NonNegative, "random initial displacement, as a fraction of dx")
+            .at_most(1.0),
         Spec::int("seed", 1, 0, "seed of the initial perturbation"),
     ];
     if D == 3 {
@@ -200,7 +202,8 @@ fn setup<const D: usize>(p: &Params) -> Result<Setup<D>, String> {
     let re = p.float("re");
     let dx = L / nx as f64;
     let nz = if D == 3 { p.int("nz") as usize } else { 1 };
-    check_size::<D>(scene, "nx", nx, (nx as f64).powi(2) * nz as f64)?;
+    let size = if D == 3 { format!("{nx} (`nz` = {nz})") } else { nx.to_string() };
+    check_size::<D>(scene, "nx", size, (nx as f64).powi(2) * nz as f64)?;
     let constants = FluidConstants::internal_flow(RHO0, C0, U, L, re, dx);
     let (kernel, h, scheme) = fluid_scheme::<D>(scene, p, &constants)?;
     let depth = nz as f64 * dx;

@@ -3,7 +3,7 @@
 //! group's grid expanded into one case per combination (like automan's `mdict`/`dprod`),
 //! named from the group's template, and the same simulation under two names run once.
 
-use super::model::{valid_name, Case, Problem};
+use super::model::{valid_name, Case, Problem, MAX_CASES};
 use super::schema::{Loc, ProblemFile, RawParams, Span};
 use crate::scenes::params::{Params, Spec, Value};
 use crate::scenes::{self, SceneEntry};
@@ -172,7 +172,18 @@ impl Expand<'_> {
                 set_keys.retain(|(s, _)| s != k);
                 set_keys.push((k.clone(), vals));
             }
-            // Product of the grid (like automan's mdict/dprod).
+            // Product of the grid (like automan's mdict/dprod), counted before it is made:
+            // seven lists of ten values would make ten million cases.
+            let count = set_keys.iter().fold(1f64, |n, (_, vals)| n * vals.len() as f64);
+            if cases.len() as f64 + count > MAX_CASES as f64 {
+                return Err(loc.err(
+                    gspan.clone(),
+                    "cases.grid",
+                    format!(
+                        "this group makes {count:.0} case(s), which brings the problem past {MAX_CASES}: more than one problem can run"
+                    ),
+                ));
+            }
             let mut combos: Vec<Params> = vec![fixed];
             for (k, vals) in &set_keys {
                 combos = combos

@@ -99,7 +99,8 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
     // resolution this machine cannot hold, ...), found before anything runs; for the preset
     // asked for only, since the others may be meant for a larger machine.
     for c in &problem.cases {
-        (scene.check)(&c.params)
+        crate::scenes::harness::check_times(scene.name, &c.params)
+            .and_then(|()| (scene.check)(&c.params))
             .map_err(|e| format!("{}: case `{}` (preset {preset}): {e}", path.display(), c.name))?;
     }
     Ok(problem)

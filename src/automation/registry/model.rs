@@ -11,6 +11,10 @@ use std::path::PathBuf;
 /// The preset used when none is named.
 pub const DEFAULT_PRESET: &str = "quick";
 
+/// The most cases a problem may have in a preset: far more than any problem here runs,
+/// few enough to expand and check at once.
+pub const MAX_CASES: usize = 10_000;
+
 /// One simulation: a scene with every parameter resolved.
 #[derive(Clone, Debug)]
 pub struct Case {
