@@ -102,3 +102,25 @@ pub fn read(output: &Path) -> Queue {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_case_is_known_by_its_problem_and_folder_whatever_the_path_to_it() {
+        assert_eq!(key(Path::new("output/tg/a-0123456789")), "tg/a-0123456789");
+        assert_eq!(key(Path::new("/home/u/run/./output/tg/a-0123456789")), "tg/a-0123456789");
+        let state = |state: &str, reason: &str| TaskState {
+            state: state.into(),
+            node: "n7".into(),
+            reason: reason.into(),
+            exit: 0,
+            signal: 0,
+        };
+        let q = Queued { task: "12_3".into(), state: state("RUNNING", "None") };
+        assert_eq!((q.word(), q.detail().as_str()), ("running", "slurm 12_3 on n7"));
+        let q = Queued { task: "12_4".into(), state: state("PENDING", "Priority") };
+        assert_eq!((q.word(), q.detail().as_str()), ("queued", "slurm 12_4: Priority"));
+    }
+}

@@ -21,7 +21,7 @@
 
 use serde::Deserialize;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 /// The settings file's name in the problems folder.
 pub const FILE_NAME: &str = "slurm.toml";
@@ -380,14 +380,6 @@ pub fn time_seconds(t: &str) -> Option<u64> {
 fn is_memory(m: &str) -> bool {
     let digits = m.trim_end_matches(['K', 'M', 'G', 'T', 'k', 'm', 'g', 't']);
     m.len() - digits.len() <= 1 && !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
-}
-
-/// The settings file that [`Settings::load`] reads for `problems_dir` and `explicit`, if any.
-pub fn path(explicit: Option<&Path>, problems_dir: &Path) -> Option<PathBuf> {
-    match explicit {
-        Some(p) => Some(p.to_path_buf()),
-        None => Some(problems_dir.join(FILE_NAME)).filter(|p| p.exists()),
-    }
 }
 
 #[cfg(test)]

@@ -204,6 +204,12 @@ pub fn wait(
         }
     }
     bar.finish_and_clear();
+    if !interrupted {
+        // Every task has ended: `status` need not ask Slurm about these again.
+        for sub in &subs {
+            let _ = std::fs::write(sub.dir.join("ended"), b"");
+        }
+    }
     let mut report = Report { interrupted, ..Default::default() };
     for t in all.iter().filter(|t| !t.replaced) {
         if done(&t.case.dir).is_some() {
