@@ -114,7 +114,11 @@ pub fn dry_run(
     let reasons: std::collections::HashMap<String, &str> =
         tasks.iter().map(|t| (queue::key(&t.entry.dir), t.reason.as_str())).collect();
     for s in &subs {
-        println!("would submit a job array of {} task(s) (settings: {}):", s.cases.len(), settings.source);
+        println!(
+            "would submit a job array of {} task(s) (settings: {}):",
+            s.cases.len(),
+            settings.describe()
+        );
         for (i, c) in s.cases.iter().enumerate() {
             let reason = reasons.get(&queue::key(&c.dir)).copied().unwrap_or_default();
             println!("  task {i}: {}/{} ({reason})  -> {}", c.problem, c.case, c.dir.display());

@@ -93,7 +93,8 @@ pub fn render(job: &Job, name: &str, dir: &Path, n: usize, throttle: Option<usiz
     for line in &job.sbatch {
         directive(line.clone());
     }
-    s += "set -eu\n";
+    // -e: a failing setup line ends the task (not -u: module systems read unset variables).
+    s += "set -e\n";
     s += &format!("SUBMISSION={}\n", quote(&dir.display().to_string()));
     s += "SPHREPRO_CASE_DIR=$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" \"$SUBMISSION/dirs.txt\")\n";
     s += "export SPHREPRO_CASE_DIR\n";

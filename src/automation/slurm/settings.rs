@@ -244,6 +244,17 @@ impl Settings {
         Ok(())
     }
 
+    /// Where the settings came from, in words: the file (or `defaults`) and the flags.
+    pub fn describe(&self) -> String {
+        if self.from_cli.is_empty() {
+            self.source.clone()
+        } else {
+            let flags: Vec<String> =
+                self.from_cli.iter().map(|k| format!("--{}", k.replace('_', "-"))).collect();
+            format!("{}, with {}", self.source, flags.join(" "))
+        }
+    }
+
     /// The job the cases of `problem` are submitted with.
     pub fn job(&self, problem: &str) -> &Job {
         self.problems.get(problem).unwrap_or(&self.base)
