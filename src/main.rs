@@ -1,8 +1,8 @@
 //! The `sphrepro` command line. Thin: every command calls into the library.
 
 use clap::{Args, Parser, Subcommand};
-use sphrepro::automation::commands::{self, Dirs, RunFlags};
-use sphrepro::automation::runner;
+use sphrepro::automation::commands::{self, Dirs, Executor, RunFlags};
+use sphrepro::automation::{runner, slurm};
 use sphrepro::bench;
 use sphrepro::scenes::{self, harness};
 use sphrepro::{errln, outln};
@@ -82,8 +82,97 @@ struct RunArgs {
     /// Regenerate figures and tables from cached results without simulating.
     #[arg(long)]
     plot_only: bool,
+    /// Only the cases that failed before (a failed summary, or a folder without one).
+    #[arg(long)]
+    retry_failed: bool,
+    #[command(flatten)]
+    slurm: SlurmArgs,
     #[command(flatten)]
     dirs: DirArgs,
+}
+
+/// Where the cases of `run` and `reproduce` run.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ExecutorName {
+    /// Subprocesses on this machine.
+    Local,
+    /// One Slurm job array, a task per case (README: "On a cluster").
+    Slurm,
+}
+
+/// `--executor slurm` and its settings; each setting wins over the settings file.
+#[derive(Args, Clone)]
+#[command(next_help_heading = "Cluster (--executor slurm)")]
+struct SlurmArgs {
+    /// Where the cases run: local, or as a Slurm job array (a task per case; --jobs then
+    /// caps the tasks running at once).
+    #[arg(long, value_enum, default_value = "local")]
+    executor: ExecutorName,
+    /// Slurm settings file (default: slurm.toml in the problems folder, if there is one).
+    #[arg(long, value_name = "FILE")]
+    slurm_config: Option<PathBuf>,
+    /// Slurm partition.
+    #[arg(long)]
+    partition: Option<String>,
+    /// Slurm account.
+    #[arg(long)]
+    account: Option<String>,
+    /// Time limit of each case's task (MM, HH:MM:SS, D-HH:MM:SS); a task near it
+    /// checkpoints and is requeued.
+    #[arg(long)]
+    time: Option<String>,
+    /// CPUs of each case's task (the simulation's threads).
+    #[arg(long, value_parser = at_least_one::<u32>)]
+    cpus_per_task: Option<u32>,
+    /// Memory of each case's task (e.g. 4G).
+    #[arg(long)]
+    mem: Option<String>,
+    /// An extra #SBATCH option, e.g. --sbatch=--qos=long (repeatable; added to the file's).
+    #[arg(long, value_name = "OPTION", allow_hyphen_values = true)]
+    sbatch: Vec<String>,
+    /// A command each task runs before its simulation, e.g. 'module load gcc'
+    /// (repeatable; added to the file's).
+    #[arg(long, value_name = "COMMAND")]
+    setup: Vec<String>,
+    /// Return once submitted; `status` shows the queued and running cases.
+    #[arg(long)]
+    no_wait: bool,
+}
+
+impl SlurmArgs {
+    /// The executor, or the Slurm flag given without `--executor slurm`.
+    fn executor(&self) -> Result<Executor, String> {
+        if self.executor == ExecutorName::Local {
+            let given = [
+                ("--slurm-config", self.slurm_config.is_some()),
+                ("--partition", self.partition.is_some()),
+                ("--account", self.account.is_some()),
+                ("--time", self.time.is_some()),
+                ("--cpus-per-task", self.cpus_per_task.is_some()),
+                ("--mem", self.mem.is_some()),
+                ("--sbatch", !self.sbatch.is_empty()),
+                ("--setup", !self.setup.is_empty()),
+                ("--no-wait", self.no_wait),
+            ];
+            if let Some((flag, _)) = given.iter().find(|(_, g)| *g) {
+                return Err(format!("{flag} is a Slurm setting: add --executor slurm"));
+            }
+            return Ok(Executor::Local);
+        }
+        Ok(Executor::Slurm(slurm::Request {
+            config: self.slurm_config.clone(),
+            overrides: slurm::settings::Overrides {
+                partition: self.partition.clone(),
+                account: self.account.clone(),
+                time: self.time.clone(),
+                cpus_per_task: self.cpus_per_task,
+                mem: self.mem.clone(),
+                sbatch: self.sbatch.clone(),
+                setup: self.setup.clone(),
+            },
+            wait: !self.no_wait,
+        }))
+    }
 }
 
 impl RunArgs {
@@ -95,6 +184,16 @@ impl RunArgs {
             dry_run: self.dry_run,
             checkpoint_every: Some(30.0),
         }
+    }
+
+    /// What `run` and `reproduce` do besides simulating.
+    fn flags(&self, manuscript: bool) -> Result<RunFlags, String> {
+        Ok(RunFlags {
+            plot_only: self.plot_only,
+            manuscript,
+            executor: self.slurm.executor()?,
+            retry_failed: self.retry_failed,
+        })
     }
 }
 
@@ -227,6 +326,15 @@ enum Command {
         #[arg(long, hide = true)]
         lock_fd: Option<i32>,
     },
+    /// One task of a Slurm job array: its case from the manifest (used by --executor slurm).
+    #[command(hide = true)]
+    SlurmTask {
+        /// The submission's manifest.json.
+        manifest: PathBuf,
+        /// The case's index in it (default: SLURM_ARRAY_TASK_ID).
+        #[arg(long)]
+        index: Option<usize>,
+    },
     /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
     Bench(BenchArgs),
     /// One benchmark configuration in this process (used by `bench`).
@@ -332,20 +440,21 @@ fn run(cli: Cli) -> u8 {
             print_scenes();
             0
         }
-        Command::Run { problem, args } => commands::run(
-            &args.dirs.dirs(),
-            &args.preset,
-            &problem,
-            &args.options(),
-            &RunFlags { plot_only: args.plot_only, manuscript: false },
-        ),
-        Command::Reproduce { args } => commands::run(
-            &args.dirs.dirs(),
-            &args.preset,
-            &[],
-            &args.options(),
-            &RunFlags { plot_only: args.plot_only, manuscript: true },
-        ),
+        Command::Run { problem, args } => match args.flags(false) {
+            Ok(flags) => commands::run(&args.dirs.dirs(), &args.preset, &problem, &args.options(), &flags),
+            Err(e) => {
+                errln!("error: {e}");
+                commands::BAD_INPUT
+            }
+        },
+        Command::Reproduce { args } => match args.flags(true) {
+            Ok(flags) => commands::run(&args.dirs.dirs(), &args.preset, &[], &args.options(), &flags),
+            Err(e) => {
+                errln!("error: {e}");
+                commands::BAD_INPUT
+            }
+        },
+        Command::SlurmTask { manifest, index } => slurm::task::run(&manifest, index),
         Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(), &preset, stale),
         Command::Check { preset, dirs } => commands::check(&dirs.dirs(), &preset),
         Command::Simulate {

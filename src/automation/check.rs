@@ -116,6 +116,8 @@ pub struct StatusCounts {
     pub missing: usize,
     /// Folders that belong to no current case.
     pub stale_folders: usize,
+    /// Not done, and pending or running in a Slurm queue.
+    pub queued: usize,
 }
 
 /// The simulated and end time a running case last wrote to its `progress` file.
@@ -132,11 +134,31 @@ fn progress(dir: &Path) -> Option<(f64, f64)> {
 /// counted.
 pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCounts {
     let mut n = StatusCounts::default();
+    // Cases submitted to Slurm: queued or running there (never done from there).
+    let queue = super::slurm::queue::read(output);
+    if let Some(w) = &queue.warning {
+        crate::outln!("warning: {w}");
+    }
     for p in problems {
         outln!("{} ({}, preset {}):", p.name, p.title, p.preset);
         let entries = cache::entries(output, p);
         for e in &entries {
             let st = e.state();
+            let slurm = match st {
+                State::Done(_) => None,
+                _ => queue.cases.get(&super::slurm::queue::key(&e.dir)),
+            };
+            if let Some(q) = slurm {
+                n.queued += 1;
+                crate::outln!(
+                    "  {:<10} {}  ({}{})",
+                    q.word(),
+                    e.case.name,
+                    q.detail(),
+                    progress(&e.dir).map(|(t, tf)| format!("; t = {t:.3} of {tf} s")).unwrap_or_default()
+                );
+                continue;
+            }
             match st {
                 State::Done(_) => n.done += 1,
                 State::Failed(_) => n.failed += 1,
@@ -211,8 +233,10 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
         }
     }
     let damaged = if n.damaged > 0 { format!(", {} damaged", n.damaged) } else { String::new() };
+    let queued =
+        if n.queued > 0 { format!(", {} queued or running in Slurm", n.queued) } else { String::new() };
     outln!(
-        "{} done, {} failed{damaged}, {} missing, {} stale folder(s)",
+        "{} done, {} failed{damaged}, {} missing, {} stale folder(s){queued}",
         n.done,
         n.failed,
         n.missing,

@@ -3,7 +3,7 @@
 
 use super::registry::{self, Problem};
 use super::runner::{self, Options};
-use super::{cache, check};
+use super::{cache, check, slurm};
 use crate::{errln, outln};
 use std::path::{Path, PathBuf};
 
@@ -97,6 +97,20 @@ pub struct RunFlags {
     pub plot_only: bool,
     /// Also write manuscript.md.
     pub manuscript: bool,
+    /// Where the cases run.
+    pub executor: Executor,
+    /// Only the cases that failed before (a failed summary, or a folder without one).
+    pub retry_failed: bool,
+}
+
+/// Where the cases run.
+#[derive(Clone, Debug, Default)]
+pub enum Executor {
+    /// Subprocesses of this process, in a job pool (`runner`).
+    #[default]
+    Local,
+    /// Job arrays on a Slurm cluster (`slurm`).
+    Slurm(slurm::Request),
 }
 
 /// `run` (and `reproduce` with every problem): simulate what is missing or stale, then
@@ -110,8 +124,19 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
         }
     };
     let mut status = OK;
+    // Slurm's settings are checked first: a bad file or flag submits nothing.
+    let slurm = match &flags.executor {
+        Executor::Slurm(request) if !flags.plot_only => match slurm::settings(&dirs.problems, request) {
+            Ok(s) => Some((request, s)),
+            Err(e) => {
+                errln!("error: {e}");
+                return BAD_INPUT;
+            }
+        },
+        _ => None,
+    };
     if !flags.plot_only {
-        let runner::Plan { tasks, done, damaged } = match runner::plan(&dirs.output, &problems, opts) {
+        let runner::Plan { mut tasks, done, damaged } = match runner::plan(&dirs.output, &problems, opts) {
             Ok(t) => t,
             Err(e) => {
                 errln!("error: {e}");
@@ -124,6 +149,26 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
         }
         if !damaged.is_empty() {
             status = FAILED;
+        }
+        if flags.retry_failed {
+            // Not a case that is running now: its folder has no summary yet either.
+            tasks.retain(|t| {
+                matches!(t.entry.state(), cache::State::Failed(_))
+                    && super::lock::Lock::holder(&t.entry.dir).is_none()
+            });
+        }
+        if slurm.is_some() {
+            slurm::leave_out_queued(&dirs.output, &mut tasks);
+        }
+        if let (true, Some((_, settings))) = (opts.dry_run, &slurm) {
+            if let Err(slurm::Error::Input(e) | slurm::Error::Failed(e)) =
+                slurm::dry_run(&dirs.output, &tasks, settings, opts.jobs, opts.force)
+            {
+                errln!("error: {e}");
+                return BAD_INPUT;
+            }
+            outln!("{} to run, {done} done (skipped)", tasks.len());
+            return OK;
         }
         if opts.dry_run {
             for t in &tasks {
@@ -143,7 +188,29 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
             return FAILED;
         }
         outln!("{} case(s) to run, {done} done (skipped)", tasks.len());
-        let report = match runner::execute(tasks, opts) {
+        let report = match &slurm {
+            None => runner::execute(tasks, opts),
+            Some((request, settings)) => {
+                match slurm::execute(
+                    &dirs.output,
+                    &tasks,
+                    settings,
+                    request,
+                    opts.jobs,
+                    opts.force,
+                    opts.checkpoint_every,
+                ) {
+                    Ok(slurm::Outcome::Submitted) => return OK,
+                    Ok(slurm::Outcome::Waited(r)) => Ok(r),
+                    Err(slurm::Error::Input(e)) => {
+                        errln!("error: {e}");
+                        return BAD_INPUT;
+                    }
+                    Err(slurm::Error::Failed(e)) => Err(e),
+                }
+            }
+        };
+        let report = match report {
             Ok(r) => r,
             Err(e) => {
                 errln!("error: {e}");
@@ -151,7 +218,10 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
             }
         };
         if report.interrupted {
-            errln!("interrupted: running cases were stopped and are not done");
+            // (The Slurm executor has said what became of its jobs.)
+            if slurm.is_none() {
+                errln!("interrupted: running cases were stopped and are not done");
+            }
             status = INTERRUPTED;
         }
         if !report.failures.is_empty() {
@@ -261,7 +331,7 @@ pub fn status(dirs: &Dirs, preset: &str, list_stale: bool) -> u8 {
     match load(dirs, preset, &[]) {
         Ok(ps) => {
             let n = check::status(&dirs.output, &ps, list_stale);
-            if n.failed + n.damaged + n.missing == 0 {
+            if n.failed + n.damaged + n.missing + n.queued == 0 {
                 OK
             } else {
                 FAILED

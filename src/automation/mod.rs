@@ -3,6 +3,7 @@
 //! - [`registry`]: problems from `problems/*.toml`, checked and expanded into cases;
 //! - [`cache`] and [`lock`]: one folder per case keyed by a sha2 digest, one runner per case;
 //! - [`runner`]: a job pool of `simulate` subprocesses;
+//! - [`slurm`]: the same cases as job arrays on a Slurm cluster;
 //! - [`check`]: bounds for CI and case states;
 //! - [`study`]: the figures and tables a problem declares, the speed-accuracy trade and
 //!   stability maps, and the manuscript;
@@ -19,6 +20,7 @@ pub mod lock;
 pub mod registry;
 pub mod report;
 pub mod runner;
+pub mod slurm;
 pub mod study;
 
 #[cfg(test)]

@@ -22,6 +22,9 @@ impl SceneRun for Fake {
     fn particles(&self) -> usize {
         1
     }
+    fn body_particles(&self) -> Vec<(String, usize)> {
+        vec![("fake".into(), 1)]
+    }
     fn time(&self) -> f64 {
         self.t
     }

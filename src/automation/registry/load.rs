@@ -15,6 +15,8 @@ pub fn load_dir(dir: &Path, preset: &str) -> Result<Vec<Problem>, String> {
     let mut paths: Vec<PathBuf> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        // The Slurm executor's settings live with the problems; they are not a problem.
+        .filter(|p| p.file_name().is_none_or(|n| n != crate::automation::slurm::settings::FILE_NAME))
         .collect();
     paths.sort();
     if paths.is_empty() {

@@ -39,6 +39,47 @@ pub struct Provenance {
     pub started: String,
     /// End, RFC 3339.
     pub finished: String,
+    /// The Slurm job that wrote it, when one did (absent otherwise, and from results written
+    /// before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slurm: Option<SlurmJob>,
+}
+
+/// The Slurm job a run was part of, from the environment Slurm gives its jobs.
+#[derive(Clone, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SlurmJob {
+    /// `SLURM_JOB_ID` (for an array task, the task's own job id).
+    pub job_id: String,
+    /// `SLURM_ARRAY_JOB_ID`, for an array task.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array_job_id: Option<String>,
+    /// `SLURM_ARRAY_TASK_ID`, for an array task.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub array_task_id: Option<String>,
+    /// `SLURMD_NODENAME`: the node it ran on.
+    pub node: String,
+    /// `SLURM_CLUSTER_NAME`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cluster: Option<String>,
+    /// `SLURM_RESTART_COUNT`: how often the job was requeued before this run (a run resumed
+    /// after its time limit has 1 or more).
+    #[serde(default)]
+    pub restarts: u32,
+}
+
+impl SlurmJob {
+    /// The job this process runs in, if it runs in one (`SLURM_JOB_ID` is set).
+    pub fn from_env() -> Option<Self> {
+        let var = |k: &str| std::env::var(k).ok().filter(|v| !v.is_empty());
+        Some(Self {
+            job_id: var("SLURM_JOB_ID")?,
+            array_job_id: var("SLURM_ARRAY_JOB_ID"),
+            array_task_id: var("SLURM_ARRAY_TASK_ID"),
+            node: var("SLURMD_NODENAME").unwrap_or_else(hostname),
+            cluster: var("SLURM_CLUSTER_NAME"),
+            restarts: var("SLURM_RESTART_COUNT").and_then(|r| r.parse().ok()).unwrap_or(0),
+        })
+    }
 }
 
 /// The version of the solver's results: raised whenever they change for unchanged
@@ -59,6 +100,7 @@ impl Provenance {
             machine: super::machine::Machine::detect(),
             started: started.to_rfc3339(),
             finished: chrono::Utc::now().to_rfc3339(),
+            slurm: SlurmJob::from_env(),
         }
     }
 }
@@ -139,5 +181,26 @@ mod tests {
         p.as_object_mut().unwrap().remove("machine");
         let old: Provenance = serde_json::from_value(p).unwrap();
         assert_eq!(old.machine, super::super::machine::Machine::default());
+    }
+
+    /// A run outside Slurm writes no `slurm` entry, and summaries without one read back.
+    #[test]
+    fn the_slurm_job_is_recorded_only_inside_one() {
+        let mut p = Provenance::now(chrono::Utc::now());
+        p.slurm = None;
+        let v = serde_json::to_value(&p).unwrap();
+        assert!(v.get("slurm").is_none());
+        p.slurm = Some(SlurmJob {
+            job_id: "13".into(),
+            array_job_id: Some("12".into()),
+            array_task_id: Some("1".into()),
+            node: "node7".into(),
+            cluster: None,
+            restarts: 1,
+        });
+        let v = serde_json::to_value(&p).unwrap();
+        assert_eq!(v["slurm"]["array_task_id"], "1");
+        let back: Provenance = serde_json::from_value(v).unwrap();
+        assert_eq!(back.slurm, p.slurm);
     }
 }
