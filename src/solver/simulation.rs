@@ -261,6 +261,16 @@ impl<const D: usize> Builder<D> {
         let radius = kernel.support() * f.h;
         let surface = f.physics.free_surface.map(|_| SurfaceFields::default());
         domain.check_periodic(radius)?;
+        // Each body's cell list spans the box: one far larger than its particles need (a
+        // box holding a long prescribed travel, say) would take the memory, or overflow.
+        let cells = CellList::<D>::cell_count(&domain, radius);
+        let particles: usize = bodies.iter().map(Body::len).sum();
+        if cells > 64.0 * particles as f64 + 4e6 {
+            return Err(format!(
+                "the box from {:?} to {:?} makes {cells:.3e} cells of the search radius {radius:.3e} for {particles} particles: too large a box for its particles",
+                domain.min, domain.max
+            ));
+        }
         let rates = bodies
             .iter()
             .map(|b| match b {

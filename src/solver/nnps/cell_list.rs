@@ -65,6 +65,17 @@ impl<const D: usize> CellList<D> {
         }
     }
 
+    /// The number of cells a list for queries of `radius` in `domain` would have (as a
+    /// float: it may not fit an integer), before it is made.
+    pub fn cell_count(domain: &Domain<D>, radius: f64) -> f64 {
+        (0..D)
+            .map(|k| {
+                let cells = domain.length(k) / radius;
+                if domain.periodic[k] { cells.floor() } else { cells.ceil() }.max(1.0)
+            })
+            .product()
+    }
+
     /// The search radius.
     pub fn radius(&self) -> f64 {
         self.radius
