@@ -46,17 +46,22 @@ struct DirArgs {
     /// Folder of results (one sub-folder per problem and case).
     #[arg(long, default_value = "output")]
     output: PathBuf,
-    /// Folder of figures/, tables/ and manuscript.md.
-    #[arg(long, default_value = "manuscript")]
-    manuscript: PathBuf,
+    /// Folder of figures/, tables/ and manuscript.md [default: `manuscript` for the paper
+    /// preset, whose results are committed; OUTPUT/manuscript for any other].
+    #[arg(long)]
+    manuscript: Option<PathBuf>,
 }
 
 impl DirArgs {
-    fn dirs(&self) -> Dirs {
+    /// The folders for `preset` (which decides the manuscript's when none is named).
+    fn dirs(&self, preset: &str) -> Dirs {
         Dirs {
             problems: self.problems.clone(),
             output: self.output.clone(),
-            manuscript: self.manuscript.clone(),
+            manuscript: self
+                .manuscript
+                .clone()
+                .unwrap_or_else(|| commands::default_manuscript(preset, &self.output)),
         }
     }
 }
@@ -79,7 +84,7 @@ struct RunArgs {
     /// Print what would run and why; run nothing.
     #[arg(long)]
     dry_run: bool,
-    /// Regenerate figures and tables from cached results without simulating.
+    /// Regenerate figures and tables from cached and committed results without simulating.
     #[arg(long)]
     plot_only: bool,
     /// Only the cases that failed before (a failed summary, or a folder without one).
@@ -269,7 +274,8 @@ enum Command {
         #[command(flatten)]
         args: RunArgs,
     },
-    /// Every problem, every figure and table, and manuscript.md.
+    /// Every problem, figure, table and manuscript.md: the paper preset's in manuscript/ (its
+    /// results exported to results/), another preset's smoke check in OUTPUT/manuscript/.
     Reproduce {
         #[command(flatten)]
         args: RunArgs,
@@ -433,7 +439,7 @@ fn install_signal_handlers() {
 fn run(cli: Cli) -> u8 {
     match cli.command {
         Command::List { preset, dirs } => {
-            let code = commands::list(&dirs.dirs(), &preset);
+            let code = commands::list(&dirs.dirs(&preset), &preset);
             if code != 0 {
                 return code;
             }
@@ -441,22 +447,26 @@ fn run(cli: Cli) -> u8 {
             0
         }
         Command::Run { problem, args } => match args.flags(false) {
-            Ok(flags) => commands::run(&args.dirs.dirs(), &args.preset, &problem, &args.options(), &flags),
+            Ok(flags) => {
+                commands::run(&args.dirs.dirs(&args.preset), &args.preset, &problem, &args.options(), &flags)
+            }
             Err(e) => {
                 errln!("error: {e}");
                 commands::BAD_INPUT
             }
         },
         Command::Reproduce { args } => match args.flags(true) {
-            Ok(flags) => commands::run(&args.dirs.dirs(), &args.preset, &[], &args.options(), &flags),
+            Ok(flags) => {
+                commands::run(&args.dirs.dirs(&args.preset), &args.preset, &[], &args.options(), &flags)
+            }
             Err(e) => {
                 errln!("error: {e}");
                 commands::BAD_INPUT
             }
         },
         Command::SlurmTask { manifest, index } => slurm::task::run(&manifest, index),
-        Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(), &preset, stale),
-        Command::Check { preset, dirs } => commands::check(&dirs.dirs(), &preset),
+        Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(&preset), &preset, stale),
+        Command::Check { preset, dirs } => commands::check(&dirs.dirs(&preset), &preset),
         Command::Simulate {
             scene,
             sets,

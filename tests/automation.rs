@@ -83,6 +83,7 @@ fn text(o: &Output) -> String {
 /// One case that runs for seconds, to be interrupted.
 const ONE_SLOW_CASE: &str = r#"title = "one slow case"
 scene = "taylor_green"
+paper = "ctvf"
 [presets.quick]
 [[cases]]
 name = "a"
@@ -94,6 +95,7 @@ fn three_cases(tf: f64) -> String {
     format!(
         r#"title = "tiny"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 tf = {tf}
 [presets.quick]
@@ -168,6 +170,7 @@ fn a_diverged_case_is_done_but_breaches_its_bounds() {
     let env = Env::new(
         r#"title = "blows up"
 scene = "taylor_green"
+paper = "ctvf"
 [presets.quick]
 [[cases]]
 name = "a"
@@ -279,6 +282,7 @@ fn another_presets_result_does_not_make_a_case_stale() {
     let env = Env::new(
         r#"title = "two presets"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 nx = 12
 tf = "$tf"
@@ -351,6 +355,7 @@ fn two_runs_at_once_simulate_each_case_once() {
 
 const VALID: &str = r#"title = "tiny"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 tf = 0.02
 [presets.quick]
@@ -374,7 +379,7 @@ metric = "l1_velocity_final"
 fn invalid_problem_files_are_refused_with_file_and_line() {
     let bad: &[(&str, &str, &str, &str)] = &[
         // (what, from, to, expected word; the expected line is where `to` lands)
-        ("malformed", "tf = 0.02", "tf = = 0.02", "tiny.toml:4"),
+        ("malformed", "tf = 0.02", "tf = = 0.02", "tiny.toml:5"),
         ("unknown key", "kind = \"timeseries\"", "kind = \"timeseries\"\ncolour = 1", "colour"),
         ("unknown scene", "\"taylor_green\"", "\"no_such_scene\"", "no_such_scene"),
         ("unknown parameter", "params = { nx = 14 }", "params = { nx = 14, frob = 2 }", "frob"),
@@ -388,6 +393,44 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
             "metric = \"l1_velocity_final\"\n",
             "metric = \"l1_velocity_final\"\n[[bounds]]\nmetric = \"l1_velocity_final\"\ncases = [\"b\"]\nmin = 0.5\nmax = 0.1\n",
             "min = 0.5 is above max = 0.1",
+        ),
+        // Claims: on a figure that does not exist, of a metric the scene does not write,
+        // selecting nothing, with a key a test does not take, with no trend to judge.
+        (
+            "claim on no figure",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"g\"\nclaim = \"c\"\npreset = \"quick\"\ntest = { metric = \"l1_velocity_final\", max = 1 }\nsource = \"s\"\n",
+            "no figure or table `g`",
+        ),
+        (
+            "claim of a missing metric",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"f\"\nclaim = \"c\"\npreset = \"quick\"\ntest = { metric = \"l9\", max = 1 }\nsource = \"s\"\n",
+            "no metric `l9`",
+        ),
+        (
+            "claim selecting nothing",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"f\"\nclaim = \"c\"\npreset = \"quick\"\nwhere = { nx = 99 }\ntest = { metric = \"l1_velocity_final\", max = 1 }\nsource = \"s\"\n",
+            "selects no case in preset `quick`",
+        ),
+        (
+            "claim test with an unknown key",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"f\"\nclaim = \"c\"\npreset = \"quick\"\ntest = { metric = \"l1_velocity_final\", maximum = 1 }\nsource = \"s\"\n",
+            "maximum",
+        ),
+        (
+            "claim with no trend to judge",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"f\"\nclaim = \"c\"\npreset = \"quick\"\ncases = [\"a-*\"]\ntest = { metric = \"l1_velocity_final\", decreasing = \"nx\" }\nsource = \"s\"\n",
+            "no trend to judge",
+        ),
+        (
+            "claim at a preset the problem has not",
+            "metric = \"l1_velocity_final\"\n",
+            "metric = \"l1_velocity_final\"\n[[claims]]\nfigure = \"f\"\nclaim = \"c\"\ntest = { metric = \"l1_velocity_final\", max = 1 }\nsource = \"s\"\n",
+            "no preset `paper`",
         ),
         // Valid alone, refused by the scene before anything runs (named by case, not line).
         (
@@ -416,6 +459,7 @@ fn invalid_problem_files_are_refused_with_file_and_line() {
                 || *what == "missing column"
                 || *what == "duplicate case"
                 || *what == "bound that no value can hold"
+                || what.starts_with("claim")
                 || *what == "support reaching no neighbour",
             "{what}: no line {line} in: {t}"
         );
@@ -478,6 +522,7 @@ fn status_keeps_other_presets_apart_from_stale_folders() {
         format!(
             r#"title = "tiny"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 tf = "$tf"
 [presets.quick]
@@ -529,4 +574,308 @@ fn a_damaged_time_series_names_the_command_that_repairs_it() {
     let o = env.run(&["run", "tiny", "--match", "b", "--force"]);
     let t = text(&o);
     assert!(o.status.success() && t.contains("1 case(s) to run"), "{t}");
+}
+
+/// A command of the binary in `root` with only the problems folder named (the output and
+/// manuscript folders at their defaults), as a user types it.
+fn bare(root: &std::path::Path, args: &[&str]) -> Output {
+    Command::new(BIN).current_dir(root).args(args).output().unwrap()
+}
+
+/// Every file under `dir` with its bytes, by path relative to it.
+fn files(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec<u8>> {
+    fn walk(
+        base: &std::path::Path,
+        d: &std::path::Path,
+        out: &mut std::collections::BTreeMap<String, Vec<u8>>,
+    ) {
+        for e in std::fs::read_dir(d).unwrap().flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                walk(base, &p, out);
+            } else {
+                out.insert(p.strip_prefix(base).unwrap().display().to_string(), std::fs::read(&p).unwrap());
+            }
+        }
+    }
+    let mut out = std::collections::BTreeMap::new();
+    if dir.exists() {
+        walk(dir, dir, &mut out);
+    }
+    out
+}
+
+/// Two tiny presets of Taylor-Green with a figure of each kind the export serves (a time
+/// series, a particle plot at a time), a table and claims.
+const TWO_PRESETS: &str = r#"title = "tiny"
+scene = "taylor_green"
+paper = "ctvf"
+section = "4.1 Taylor-Green vortex"
+description = "A tiny vortex."
+[params]
+tf = "$tf"
+[presets.quick]
+tf = 0.02
+nx = [12]
+[presets.paper]
+tf = 0.03
+nx = [12, 14]
+[[cases]]
+name = "nx{nx}"
+grid = { nx = "$nx" }
+[[figures]]
+id = "fig06a_decay"
+number = "Fig. 6a"
+paper_caption = "The decay of max |u|."
+kind = "timeseries"
+title = "decay"
+y = "u_max"
+exact = "u_max_exact"
+label = ["nx"]
+metric = "l1_velocity_final"
+caption = "Our decay."
+[[figures]]
+id = "fig12_pressure"
+number = "Fig. 12"
+paper_caption = "The pressure."
+kind = "particles"
+title = "pressure"
+field = "pressure"
+time = 0.02
+cases = ["nx12"]
+caption = "Our pressure."
+[[figures]]
+id = "stability_nx"
+kind = "stability"
+title = "stability"
+x = "nx"
+metric = "l1_velocity_final"
+max = 1.0
+[[tables]]
+id = "table_errors"
+title = "errors"
+columns = ["nx"]
+metrics = ["l1_velocity_final"]
+[[claims]]
+figure = "fig06a_decay"
+claim = "Close to the exact decay."
+test = { metric = "l1_velocity_final", max = 1.0 }
+source = "A generous tolerance."
+[[claims]]
+figure = "fig06a_decay"
+claim = "Exactly the exact decay."
+test = { metric = "l1_velocity_final", max = 1e-12 }
+source = "An impossible tolerance."
+"#;
+
+/// The paper preset's results are exported into `results/` (summaries, time series, only the
+/// snapshots figures draw, gzip-compressed; the other preset's summaries that a stability
+/// table reads, marked as such); on a fresh clone (no output folder) the cache takes the
+/// paper preset's as done, and `reproduce --plot-only --preset paper` simulates nothing and
+/// writes the committed manuscript, figures and tables byte for byte. The quick preset's
+/// manuscript goes under the output folder, titled as a smoke check, and never touches
+/// `manuscript/`.
+#[test]
+fn the_paper_presets_results_are_committed_and_redrawn_byte_for_byte() {
+    let env = Env::new(TWO_PRESETS);
+    let root = &env.root;
+    // The quick preset: its manuscript under output/, a smoke check; manuscript/ untouched.
+    let o = bare(root, &["reproduce"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let quick = std::fs::read_to_string(root.join("output/manuscript/manuscript.md")).unwrap();
+    assert!(quick.starts_with("# Smoke check (quick preset): not the paper's resolutions"), "{quick}");
+    assert!(!root.join("manuscript").exists() && !root.join("results").exists());
+    // The paper preset.
+    let o = bare(root, &["reproduce", "--preset", "paper"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(t.contains("exported 2 case(s), 1 summary(ies) of other presets"), "{t}");
+    let results = root.join("results/tiny");
+    let dirs: Vec<_> = std::fs::read_dir(&results).unwrap().flatten().map(|e| e.path()).collect();
+    assert_eq!(dirs.len(), 3, "{dirs:?}");
+    let key = |d: &std::path::PathBuf| {
+        let r: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("case.json")).unwrap()).unwrap();
+        (r["params"]["nx"].as_i64().unwrap(), r["params"]["tf"].as_f64().unwrap())
+    };
+    let nx12 = dirs.iter().find(|d| key(d) == (12, 0.03)).unwrap();
+    // The quick preset's case, for the stability table: its summary only, marked.
+    let quick12 = dirs.iter().find(|d| key(d) == (12, 0.02)).unwrap();
+    assert!(quick12.join("SUMMARY_ONLY").exists() && !quick12.join("timeseries.csv").exists());
+    for f in ["case.json", "summary.json", "timeseries.csv", "fluid.pvd"] {
+        assert!(nx12.join(f).exists(), "{f}");
+    }
+    // One snapshot, the one fig. 12 draws, compressed; the series lists it by its plain name.
+    let snaps: Vec<_> =
+        std::fs::read_dir(nx12.join("vtu")).unwrap().flatten().map(|e| e.file_name()).collect();
+    assert_eq!(snaps.len(), 1, "{snaps:?}");
+    assert!(snaps[0].to_string_lossy().ends_with(".vtu.gz"));
+    let pvd = std::fs::read_to_string(nx12.join("fluid.pvd")).unwrap();
+    assert_eq!(pvd.matches("<DataSet").count(), 1);
+    assert!(pvd.contains(".vtu\"") && !pvd.contains(".gz"), "{pvd}");
+    let nx14 = dirs.iter().find(|d| key(d).0 == 14).unwrap();
+    assert!(!nx14.join("vtu").exists(), "no figure draws nx14's snapshots");
+    assert!(!nx12.join("SUMMARY_ONLY").exists());
+    // The manuscript: the paper's, with computed verdicts and nothing that changes by run.
+    let md = std::fs::read_to_string(root.join("manuscript/manuscript.md")).unwrap();
+    assert!(md.contains("#### Fig. 6a") && md.contains("#### Fig. 12"), "{md}");
+    assert!(md.contains("**Verdict: reproduced** at the paper's resolutions"), "{md}");
+    assert!(
+        md.contains("**Verdict: not reproduced** at the paper's resolutions") && md.contains("> 1e-12"),
+        "{md}"
+    );
+    let date = md.as_bytes().windows(10).any(|w| {
+        w.iter().enumerate().all(|(i, c)| if i == 4 || i == 7 { *c == b'-' } else { c.is_ascii_digit() })
+    });
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(nx12.join("summary.json")).unwrap()).unwrap();
+    let commit = summary["provenance"]["git_commit"].as_str().unwrap_or_default().to_string();
+    let host = summary["provenance"]["host"].as_str().unwrap_or_default().to_string();
+    assert!(!date && !md.contains("git_"), "{md}");
+    assert!(commit.len() < 7 || !md.contains(&commit[..7]), "{md}");
+    assert!(host.is_empty() || !md.contains(&format!("{host} ")), "{md}");
+    // The stability table has a row at each preset.
+    let first =
+        std::fs::read_to_string(root.join("manuscript/tables/stability_nx_first_failure.md")).unwrap();
+    assert!(first.contains("| paper | nx12 |") || first.contains("| paper |"), "{first}");
+    assert!(first.contains("| quick |"), "{first}");
+    let committed = files(&root.join("manuscript"));
+    let committed_results = files(&root.join("results"));
+
+    // A fresh clone: the problems, the committed results and manuscript, no output folder.
+    let clone = tempfile::tempdir().unwrap();
+    for d in ["problems", "results", "manuscript"] {
+        for (rel, bytes) in files(&root.join(d)) {
+            let p = clone.path().join(d).join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, bytes).unwrap();
+        }
+    }
+    let t = text(&bare(clone.path(), &["status", "--preset", "paper"]));
+    assert!(t.contains("2 done, 0 failed, 0 missing"), "{t}");
+    // A case of which only the summary is committed is not done: the quick preset runs it.
+    let t = text(&bare(clone.path(), &["status"]));
+    assert!(t.contains("0 done, 0 failed, 1 missing"), "{t}");
+    let t = text(&bare(clone.path(), &["run", "tiny", "--preset", "paper", "--dry-run"]));
+    assert!(t.contains("0 to run, 2 done"), "{t}");
+    let o = bare(clone.path(), &["reproduce", "--plot-only", "--preset", "paper"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(!t.contains("run ") && !clone.path().join("output").exists(), "simulated or wrote output: {t}");
+    assert_eq!(files(&clone.path().join("manuscript")), committed, "the manuscript differs");
+    assert_eq!(files(&clone.path().join("results")), committed_results, "the results changed");
+    // And so does a full `reproduce --preset paper`: nothing to run.
+    let t = text(&bare(clone.path(), &["reproduce", "--preset", "paper"]));
+    assert!(t.contains("0 case(s) to run, 2 done"), "{t}");
+    assert_eq!(files(&clone.path().join("manuscript")), committed);
+
+    // The quick preset again: manuscript/ untouched, and the paper's claims judged from the
+    // committed results.
+    let o = bare(root, &["reproduce", "--plot-only"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert_eq!(files(&root.join("manuscript")), committed, "the quick preset wrote over manuscript/");
+    let quick = std::fs::read_to_string(root.join("output/manuscript/manuscript.md")).unwrap();
+    assert!(quick.contains("**Verdict: reproduced** at the paper's resolutions"), "{quick}");
+    // And on the clone, the quick preset runs its one case and draws its figures.
+    let o = bare(clone.path(), &["reproduce"]);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("1 case(s) to run"), "{}", text(&o));
+}
+
+/// A manuscript from a small synthetic results folder (no simulation): a claim met is
+/// `reproduced`, a claim missed `not reproduced` with the number, and a claim whose
+/// resolution has no result `not run`, naming the missing case with an estimate of its cost.
+#[test]
+fn verdicts_from_a_synthetic_results_folder() {
+    use sphrepro::automation::{cache::CaseRecord, registry};
+    use sphrepro::solver::output::summary::{Provenance, Status, Summary};
+    let src = r#"title = "tiny"
+scene = "taylor_green"
+paper = "ctvf"
+section = "4.1 Taylor-Green vortex"
+[params]
+tf = 2.0
+[presets.quick]
+nx = [12]
+[presets.paper]
+nx = [20, 30, 40]
+[[cases]]
+name = "nx{nx}"
+grid = { nx = "$nx" }
+[[tables]]
+id = "table_l1"
+number = "Table 1"
+paper_caption = "The errors."
+title = "errors"
+columns = ["nx"]
+metrics = ["l1_velocity_mean"]
+[[claims]]
+figure = "table_l1"
+claim = "Small at 20 x 20."
+where = { nx = 20 }
+test = { metric = "l1_velocity_mean", max = 0.1 }
+source = "The paper's words."
+[[claims]]
+figure = "table_l1"
+claim = "Smaller still at 30 x 30."
+where = { nx = 30 }
+test = { metric = "l1_velocity_mean", max = 0.01 }
+source = "The paper's words."
+[[claims]]
+figure = "table_l1"
+claim = "Falls with the resolution."
+test = { metric = "l1_velocity_mean", decreasing = "nx" }
+source = "The paper's words."
+"#;
+    let env = Env::new(src);
+    let path = env.root.join("problems/tiny.toml");
+    let p = registry::parse(&path, src, "paper").unwrap();
+    for (case, l1) in p.cases.iter().zip([0.05, 0.03]) {
+        let record = CaseRecord::new("tiny", case);
+        let dir = env.root.join("results/tiny").join(record.folder());
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(dir.join("case.json"), serde_json::to_string_pretty(&record).unwrap()).unwrap();
+        Summary {
+            scene: "taylor_green".into(),
+            params: record.params.clone(),
+            particles: 400,
+            bodies: [("fluid".to_string(), 400)].into(),
+            steps: 1000,
+            final_time: 2.0,
+            wall_seconds: 10.0,
+            particle_steps_per_second: 4e4,
+            threads: 1,
+            wavefront_steps: 0,
+            status: Status::Completed,
+            reason: None,
+            step: None,
+            metrics: [("l1_velocity_mean".to_string(), l1)].into(),
+            provenance: Provenance::now(chrono::Utc::now()),
+        }
+        .write(&dir)
+        .unwrap();
+    }
+    let o = env.run(&["reproduce", "--plot-only", "--preset", "paper"]);
+    let t = text(&o);
+    assert!(o.status.success(), "{t}");
+    assert!(!env.root.join("output").exists(), "{t}");
+    let md = std::fs::read_to_string(env.root.join("manuscript/manuscript.md")).unwrap();
+    let verdict = |claim: &str| {
+        let at = md.find(&format!("**Claim:** {claim}")).unwrap_or_else(|| panic!("{claim}: {md}"));
+        let v = md[at..].find("**Verdict: ").unwrap() + at;
+        md[v..].lines().next().unwrap().to_string()
+    };
+    assert!(verdict("Small at 20 x 20.").starts_with("**Verdict: reproduced**"), "{md}");
+    let missed = verdict("Smaller still at 30 x 30.");
+    assert!(
+        missed.starts_with("**Verdict: not reproduced**") && missed.contains("0.0300 > 0.01"),
+        "{missed}"
+    );
+    let not_run = verdict("Falls with the resolution.");
+    assert!(not_run.starts_with("**Verdict: not run**") && not_run.contains("`nx40`"), "{not_run}");
+    // 40 x 40 from 30 x 30's 10 s: (4/3)^3 as many particle-steps.
+    assert!(not_run.contains("estimated 24 s on 1 thread, scaled from `nx30`"), "{not_run}");
+    // The summary table lists each claim with its verdict, under the paper's number.
+    assert!(md.contains("| CTVF Table 1 | Small at 20 x 20. | reproduced |"), "{md}");
+    assert!(md.contains("| CTVF Table 1 | Smaller still at 30 x 30. | **not reproduced** |"), "{md}");
 }

@@ -3,6 +3,11 @@
 //! solver fingerprint. A case is done when its `summary.json` (written atomically by
 //! `simulate`) says `completed` or `diverged`; `case.json` beside it keeps the inputs, so
 //! a stale folder can say which input changed.
+//!
+//! A second, read-only layer holds the committed results (`results/`, next to the problems
+//! folder; see [`results`](super::results)): a case whose folder there holds a finished
+//! summary is done too, so that a fresh clone runs nothing that was committed. A result in
+//! the output folder comes first (a forced rerun replaces the committed one).
 
 use super::registry::{Case, Problem};
 use crate::solver::output::summary::{Status, Summary, SCHEME_VERSION};
@@ -163,8 +168,11 @@ pub struct Entry {
     pub case: Case,
     /// Its inputs and key.
     pub record: CaseRecord,
-    /// Its folder.
+    /// Its folder, where it runs.
     pub dir: PathBuf,
+    /// Its folder in the committed results, if the problem has such a layer (it may not
+    /// exist).
+    pub committed: Option<PathBuf>,
     /// The folders of the current cases of the problem's other presets (filled by
     /// [`entries`]): their results are not earlier inputs of this case.
     others: Arc<HashSet<PathBuf>>,
@@ -184,16 +192,52 @@ impl Entry {
     pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
         let record = CaseRecord::new(&problem.name, case);
         let dir = output.join(&problem.name).join(record.folder());
-        Self { case: case.clone(), record, dir, others: Arc::default(), preset: problem.preset.clone() }
+        let committed = super::results::root(problem).map(|r| r.join(&problem.name).join(record.folder()));
+        Self {
+            case: case.clone(),
+            record,
+            dir,
+            committed,
+            others: Arc::default(),
+            preset: problem.preset.clone(),
+        }
     }
 
-    /// The summary, if there is a readable one.
+    /// Whether `dir` holds a finished (`completed` or `diverged`) summary.
+    fn finished(dir: &Path) -> bool {
+        Summary::read(dir).is_ok_and(|s| matches!(s.status, Status::Completed | Status::Diverged))
+    }
+
+    /// Where its results are read from: the output folder when it holds a finished run,
+    /// else the committed folder when that holds a whole one (not only its summary, see
+    /// [`results::SUMMARY_ONLY`](super::results::SUMMARY_ONLY)), else the output folder.
+    pub fn result_dir(&self) -> &Path {
+        if Self::finished(&self.dir) {
+            return &self.dir;
+        }
+        match &self.committed {
+            Some(c) if Self::finished(c) && !c.join(super::results::SUMMARY_ONLY).exists() => c,
+            _ => &self.dir,
+        }
+    }
+
+    /// Whether its result is the committed one (none in the output folder).
+    pub fn is_committed(&self) -> bool {
+        self.committed.as_deref().is_some_and(|c| c == self.result_dir())
+    }
+
+    /// The summary, if there is a readable one (see [`result_dir`](Self::result_dir)).
     pub fn summary(&self) -> Option<Summary> {
-        Summary::read(&self.dir).ok()
+        Summary::read(self.result_dir()).ok()
     }
 
-    /// The state of this case on disk.
+    /// The state of this case on disk: done if either layer holds a finished run.
     pub fn state(&self) -> State {
+        if self.is_committed() {
+            if let Ok(s) = Summary::read(self.result_dir()) {
+                return State::Done(s.status);
+            }
+        }
         match Summary::read(&self.dir) {
             Ok(s) if matches!(s.status, Status::Completed | Status::Diverged) => State::Done(s.status),
             Ok(s) => State::Failed(s.reason.unwrap_or_else(|| "failed".into())),

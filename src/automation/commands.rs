@@ -3,7 +3,7 @@
 
 use super::registry::{self, Problem};
 use super::runner::{self, Options};
-use super::{cache, check, slurm};
+use super::{cache, check, results, slurm, study};
 use crate::{errln, outln};
 use std::path::{Path, PathBuf};
 
@@ -20,6 +20,20 @@ pub struct Dirs {
     /// Figures, tables and manuscript.md.
     pub manuscript: PathBuf,
 }
+
+/// The manuscript folder of `preset` when none is named: `manuscript/` for the preset whose
+/// results are committed (the paper's resolutions), `OUTPUT/manuscript/` for any other (a
+/// smoke check never writes over the committed manuscript).
+pub fn default_manuscript(preset: &str, output: &Path) -> PathBuf {
+    if preset == results::EXPORT_PRESET {
+        PathBuf::from(DEFAULT_MANUSCRIPT)
+    } else {
+        output.join("manuscript")
+    }
+}
+
+/// The committed manuscript's folder.
+pub const DEFAULT_MANUSCRIPT: &str = "manuscript";
 
 /// Exit status: success.
 pub const OK: u8 = 0;
@@ -240,6 +254,36 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
         outln!("(--plot-only: nothing would be simulated)");
         return OK;
     }
+    if preset == results::EXPORT_PRESET {
+        match results::export(&problems, &dirs.output) {
+            Ok(x) => {
+                if x.cases + x.summaries > 0 {
+                    outln!(
+                        "exported {} case(s), {} summary(ies) of other presets and {} snapshot(s) to the committed results ({:.1} MB)",
+                        x.cases,
+                        x.summaries,
+                        x.snapshots,
+                        x.bytes as f64 / 1e6
+                    );
+                }
+                for (f, n) in &x.dropped {
+                    outln!(
+                        "dropped {} ({:.1} MB) to keep the committed results under {:.0} MB: the figure that draws it says so",
+                        f.display(),
+                        *n as f64 / 1e6,
+                        results::BUDGET as f64 / 1e6
+                    );
+                }
+                for (p, n) in &x.earlier {
+                    outln!("{p}: {n} committed folder(s) of earlier inputs, read by nothing (`git rm` them to keep the results small)");
+                }
+            }
+            Err(e) => {
+                errln!("error: exporting the results: {e}");
+                return FAILED;
+            }
+        }
+    }
     if let Err(e) = post_process(dirs, &problems, flags) {
         errln!("error: {e}");
         return FAILED;
@@ -247,20 +291,52 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
     status
 }
 
-/// Figures, tables and (with `flags.manuscript`) manuscript.md from cached results.
+/// Where the figures of `problems` read results: for the preset whose results are
+/// committed, the committed results alone (so that its manuscript is the same on every
+/// clone; the export above brings the output folder's new results there first); for any
+/// other, the output folder over the committed results.
+fn read_from(dirs: &Dirs, problems: &[Problem]) -> PathBuf {
+    match (problems.first().map(|p| p.preset.as_str()), results::root_of(&dirs.problems)) {
+        (Some(results::EXPORT_PRESET), Some(root)) => root,
+        _ => dirs.output.clone(),
+    }
+}
+
+/// Figures, tables and (with `flags.manuscript`) manuscript.md from cached results. A
+/// problem none of whose cases has a result draws nothing (its last figures stay); if no
+/// problem has one (a mistyped --output), nothing is written and it is an error.
 fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(), String> {
     if problems.iter().all(|p| p.figures.is_empty() && p.tables.is_empty()) && !flags.manuscript {
         return Ok(());
     }
+    let read = read_from(dirs, problems);
+    let empty: Vec<&Problem> = problems
+        .iter()
+        .filter(|p| {
+            let entries = cache::entries(&read, p);
+            !entries.is_empty() && !entries.iter().any(|e| e.is_done())
+        })
+        .collect();
+    let note = |p: &Problem| {
+        format!(
+            "{}: no case has a result under {}; its figures and tables are left as they were",
+            p.name,
+            read.display()
+        )
+    };
+    if empty.len() == problems.len() {
+        return Err(problems.iter().map(&note).collect::<Vec<_>>().join("\nerror: "));
+    }
+    for p in &empty {
+        outln!("{}", note(p));
+    }
     ensure_dir(&dirs.manuscript, "manuscript")?;
-    let mut sections = Vec::new();
+    let mut reports = Vec::new();
     let mut errors = Vec::new();
     for p in problems {
-        // Figures of nothing would overwrite the last ones drawn from results (a mistyped
-        // --output, every case failed): leave them, and say so.
-        let entries = super::cache::entries(&dirs.output, p);
-        // Nor are they drawn without a case whose result is damaged (it would be left out).
-        let damaged: Vec<String> = entries
+        // Nor are figures drawn without a case whose result is damaged (it would be left
+        // out): named, with the command that computes it again.
+        let damaged: Vec<String> = cache::entries(&read, p)
             .iter()
             .filter_map(|e| match e.state() {
                 cache::State::Damaged(r) => Some(format!("{}/{}: {r}", p.name, e.case.name)),
@@ -277,28 +353,21 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
             ));
             continue;
         }
-        if !entries.is_empty() && !entries.iter().any(|e| e.is_done()) {
-            errors.push(format!(
-                "{}: no case has a result under {}; its figures and tables are left as they were",
-                p.name,
-                dirs.output.display()
-            ));
-            continue;
-        }
-        match super::study::regenerate(p, &dirs.output, &dirs.manuscript) {
-            Ok(section) => sections.push(section),
-            Err(e) => {
-                errors.push(e);
-                continue;
+        match study::regenerate(p, &read, &dirs.manuscript) {
+            Ok(r) => {
+                if r.drawn {
+                    outln!(
+                        "{}: {} figure(s), {} table(s) in {}",
+                        p.name,
+                        p.figures.len(),
+                        p.tables.len(),
+                        dirs.manuscript.display()
+                    );
+                }
+                reports.push((p, r));
             }
+            Err(e) => errors.push(e),
         }
-        outln!(
-            "{}: {} figure(s), {} table(s) in {}",
-            p.name,
-            p.figures.len(),
-            p.tables.len(),
-            dirs.manuscript.display()
-        );
     }
     // Every problem's figures were attempted; a manuscript missing a section is not written
     // over the last whole one.
@@ -306,24 +375,46 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
         return Err(errors.join("\nerror: "));
     }
     if flags.manuscript {
+        let preset = problems.first().map(|p| p.preset.as_str()).unwrap_or(registry::DEFAULT_PRESET);
         let path = dirs.manuscript.join("manuscript.md");
-        super::report::write_manuscript(
-            &super::report::Manuscript {
-                title: "sphrepro: regenerated results".into(),
-                intro: format!(
-                    "Every figure and table below was regenerated by `sphrepro reproduce --preset {}` \
-                     from the problem files in `problems/` and the cached results; each figure says what \
-                     the paper shows and what this run got. Solver fingerprint {}.",
-                    problems.first().map(|p| p.preset.as_str()).unwrap_or("quick"),
-                    super::cache::fingerprint()
-                ),
-                sections,
-            },
-            &path,
-        )?;
+        let refs: Vec<(&Problem, &study::ProblemReport)> = reports.iter().map(|(p, r)| (*p, r)).collect();
+        super::report::write_manuscript(&study::manuscript(header(preset), &refs), &path)?;
         outln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The manuscript's title and opening paragraphs for `preset`.
+fn header(preset: &str) -> study::Header {
+    let how = format!(
+        "Every figure, table and verdict below is regenerated by `sphrepro reproduce --preset {preset}` \
+         from the problem files (`problems/`) and the results of their cases; nothing in it is written by hand \
+         but the problem files' text. Each figure or table of a paper appears under the paper's own number, with \
+         the paper's caption in our words, our figure, and the paper's claims on it. A claim is a test on the \
+         results' metrics at a stated resolution, with the source of its tolerance; its verdict is computed: \
+         *reproduced*, *not reproduced* (with the numbers), or *not run* (the results at that resolution are \
+         missing, with an estimate of what they would cost). A verdict drawn from another resolution than the \
+         paper's says so."
+    );
+    if preset == results::EXPORT_PRESET {
+        study::Header {
+            title: "sphrepro: the seed papers' figures at the papers' resolutions".into(),
+            intro: format!(
+                "{how}\n\nThe results are committed in `results/`, so `sphrepro reproduce --plot-only --preset {preset}` \
+                 on a fresh clone redraws this manuscript, byte for byte, without simulating."
+            ),
+        }
+    } else {
+        study::Header {
+            title: format!("Smoke check ({preset} preset): not the paper's resolutions"),
+            intro: format!(
+                "{how}\n\nThis is the `{preset}` preset: coarser resolutions and shorter runs than the papers', to check \
+                 in minutes that every problem runs and every figure is drawn. Its verdicts at the paper's \
+                 resolutions come from the committed results where they exist; the manuscript of the papers' \
+                 resolutions is `manuscript/manuscript.md`."
+            ),
+        }
+    }
 }
 
 /// `status`: every case's state and the stale folders. Exits 1 if any case is not done.

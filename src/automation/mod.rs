@@ -1,12 +1,15 @@
 //! The automation framework: everything above the scenes that turns runs into papers.
 //!
 //! - [`registry`]: problems from `problems/*.toml`, checked and expanded into cases;
+//! - [`papers`]: the papers reproduced, in the manuscript's order;
 //! - [`cache`] and [`lock`]: one folder per case keyed by a sha2 digest, one runner per case;
+//!   [`results`]: the committed results, a read-only second layer of the cache, and their
+//!   export;
 //! - [`runner`]: a job pool of `simulate` subprocesses;
 //! - [`slurm`]: the same cases as job arrays on a Slurm cluster;
 //! - [`check`]: bounds for CI and case states;
 //! - [`study`]: the figures and tables a problem declares, the speed-accuracy trade and
-//!   stability maps, and the manuscript;
+//!   stability maps, the verdicts on the paper's claims, and the manuscript;
 //! - [`report`]: figures, tables and the manuscript built from run results;
 //! - [`commands`]: the commands behind the CLI.
 //!
@@ -17,8 +20,10 @@ pub mod cache;
 pub mod check;
 pub mod commands;
 pub mod lock;
+pub mod papers;
 pub mod registry;
 pub mod report;
+pub mod results;
 pub mod runner;
 pub mod slurm;
 pub mod study;

@@ -97,6 +97,7 @@ pub struct Problem {
 
 pub const THREE_CASES: &str = r#"title = "tiny"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 tf = 0.02
 [presets.quick]
@@ -123,6 +124,7 @@ max = 10.0
 /// One case of a few seconds, to be interrupted.
 pub const ONE_SLOW_CASE: &str = r#"title = "one slow case"
 scene = "taylor_green"
+paper = "ctvf"
 [presets.quick]
 [[cases]]
 name = "a"

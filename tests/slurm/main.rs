@@ -100,7 +100,7 @@ fn text(o: &Output) -> String {
 
 /// Cases `a`, `b`, `c`, ... at nx = 12, 14, 16, ..., to `tf`.
 fn cases(names: &[&str], tf: f64) -> String {
-    let mut s = format!("title = \"tiny\"\nscene = \"taylor_green\"\n[params]\ntf = {tf}\n[presets.quick]\n");
+    let mut s = format!("title = \"tiny\"\nscene = \"taylor_green\"\npaper = \"ctvf\"\n[params]\ntf = {tf}\n[presets.quick]\n");
     for (i, n) in names.iter().enumerate() {
         s += &format!("[[cases]]\nname = \"{n}\"\nparams = {{ nx = {} }}\n", 12 + 2 * i);
     }

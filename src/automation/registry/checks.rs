@@ -5,10 +5,12 @@
 
 use super::expand::{check_param, resolve_raw, Expand, Raw};
 use super::model::{
-    glob_matches, valid_name, Bound, Case, Figure, FigureKind, Select, Table, DEFAULT_PRESET,
+    glob_matches, valid_name, Bound, Case, ClaimTest, Figure, FigureKind, ItemInfo, Select, Table, Test,
+    DEFAULT_PRESET,
 };
 use super::reference;
-use super::schema::{BoundFile, FigureFile, Loc, RawParams, Span, TableFile};
+use super::schema::{BoundFile, ClaimFile, FigureFile, Loc, RawParams, Span, TableFile};
+use crate::automation::papers;
 use crate::scenes::params::Value;
 use crate::scenes::SceneEntry;
 use std::collections::BTreeMap;
@@ -104,7 +106,8 @@ impl Expand<'_> {
         for (k, set, only) in [
             ("file", f.file.is_some(), "profile"),
             ("reference", f.reference.is_some(), "profile"),
-            ("x_label", f.x_label.is_some(), "profile"),
+            ("x_label", f.x_label.is_some() && f.kind != "stability", "profile"),
+            ("x_range", f.x_range.is_some(), "profile"),
             ("time", f.time.is_some(), "particles"),
             ("arrows", f.arrows.is_some(), "particles"),
             ("x_spacing", f.x_spacing, "trade"),
@@ -113,37 +116,24 @@ impl Expand<'_> {
                 return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `{only}` takes `{k}`")));
             }
         }
-        if (f.converges || f.lower.is_some()) && f.metric.is_none() {
-            return Err(loc.err(span, &key, "a claim (`converges`, `lower`) needs `metric`"));
-        }
-        if f.converges && f.label.is_empty() {
-            return Err(loc.err(span, &key, "`converges` needs `label` (the resolution last)"));
-        }
-        let lower_than = match (&f.lower, &f.higher) {
-            (Some(a), Some(b)) => {
-                let a = self.select(&a.cases, &a.where_)?;
-                let b = self.select(&b.cases, &b.where_)?;
-                nonempty(loc, span.clone(), &format!("{key}.lower"), &a, cases, preset)?;
-                nonempty(loc, span.clone(), &format!("{key}.higher"), &b, cases, preset)?;
-                Some((a, b))
-            }
-            (None, None) => None,
-            _ => return Err(loc.err(span, &key, "`lower` and `higher` go together")),
-        };
+        let info = item_info(
+            loc,
+            span.clone(),
+            &key,
+            (&f.number, &f.paper_caption, &f.section, &f.caption, &f.discussion),
+        )?;
         Ok(Figure {
             id: f.id.clone(),
             kind,
             title: f.title.clone(),
-            caption: f.caption.clone(),
-            paper: f.paper.clone(),
+            info,
+            select_at: BTreeMap::from([(preset.to_string(), select.clone())]),
             select,
             x_label: f.x_label.clone(),
             y_label: f.y_label.clone(),
             log_y: f.log_y,
             metric: f.metric.clone(),
             label: f.label.clone(),
-            converges: f.converges,
-            lower_than,
         })
     }
 
@@ -175,6 +165,30 @@ impl Expand<'_> {
             "stability" => {
                 need("metric", &f.metric)?;
                 let x = self.swept(span.clone(), key, need("x", &f.x)?)?;
+                // One case per cell of the map: two that share a row (`label`) and a column
+                // (`x`) would hide one another.
+                let picked = select.pick(cases);
+                for (i, a) in picked.iter().enumerate() {
+                    let cell = |c: &Case| -> String {
+                        let keys = f.label.iter().map(String::as_str).chain([x.as_str()]);
+                        keys.map(|k| format!("{:?}", c.params.0.get(k))).collect::<Vec<_>>().join("|")
+                    };
+                    if let Some(b) = picked[i + 1..].iter().find(|b| cell(b) == cell(a)) {
+                        let differ: Vec<&String> =
+                            a.params.0.keys().filter(|k| a.params.0.get(*k) != b.params.0.get(*k)).collect();
+                        return Err(self.loc.err(
+                            span.clone(),
+                            key,
+                            format!(
+                                "cases `{}` and `{}` fall in one cell of the map in preset `{}` (they differ in {}): narrow `where` or add to `label`",
+                                a.name,
+                                b.name,
+                                self.preset,
+                                differ.iter().map(|k| format!("`{k}`")).collect::<Vec<_>>().join(", ")
+                            ),
+                        ));
+                    }
+                }
                 let max =
                     f.max.ok_or_else(|| self.loc.err(span.clone(), key, "kind `stability` needs `max`"))?;
                 FigureKind::Stability { x, max }
@@ -188,11 +202,39 @@ impl Expand<'_> {
                         format!("`{file_name}` must be a file name in the case folder (letters, digits, `.`, `_`, `-`)"),
                     ));
                 }
-                let reference = match &f.reference {
-                    Some(r) => Some(reference::read(self.loc, r.span(), key, r.get_ref())?),
-                    None => None,
+                let mut references = Vec::new();
+                if let Some(r) = &f.reference {
+                    for one in r.get_ref().as_slice() {
+                        references.push(reference::read(self.loc, r.span(), key, one)?);
+                    }
+                }
+                let clip_to_reference = match f.x_range.as_deref() {
+                    None => false,
+                    Some("reference") if !references.is_empty() => true,
+                    Some("reference") => {
+                        return Err(self.loc.err(
+                            span.clone(),
+                            &format!("{key}.x_range"),
+                            "`x_range = \"reference\"` needs a `reference`",
+                        ))
+                    }
+                    Some(other) => {
+                        return Err(self.loc.err(
+                            span.clone(),
+                            &format!("{key}.x_range"),
+                            format!(
+                                "`{other}`: the one range is \"reference\" (the published points' x range)"
+                            ),
+                        ))
+                    }
                 };
-                FigureKind::Profile { file: file_name, x: need("x", &f.x)?, y: need("y", &f.y)?, reference }
+                FigureKind::Profile {
+                    file: file_name,
+                    x: need("x", &f.x)?,
+                    y: need("y", &f.y)?,
+                    references,
+                    clip_to_reference,
+                }
             }
             other => {
                 return Err(self.loc.err(
@@ -311,10 +353,16 @@ impl Expand<'_> {
         for c in &t.columns {
             self.parameter(span.clone(), &key, "columns", c)?;
         }
+        let info = item_info(
+            loc,
+            span.clone(),
+            &key,
+            (&t.number, &t.paper_caption, &t.section, &t.caption, &t.discussion),
+        )?;
         Ok(Table {
             id: t.id.clone(),
             title: t.title.clone(),
-            caption: t.caption.clone(),
+            info,
             select,
             columns: t.columns.clone(),
             metrics: t.metrics.clone(),
@@ -361,6 +409,186 @@ impl Expand<'_> {
             line: loc.line(span.start),
         }))
     }
+}
+
+impl Expand<'_> {
+    /// One claim in this preset: its test and selection, checked against the scene, the
+    /// cases and the problem's figure and table ids; `None` when its selection picks no case
+    /// in this preset and this is not the preset the claim is stated at (whose selection must
+    /// pick one).
+    pub(super) fn claim(
+        &self,
+        c: &Spanned<ClaimFile>,
+        cases: &[Case],
+        ids: &BTreeMap<String, usize>,
+    ) -> Result<Option<ClaimTest>, String> {
+        let Expand { loc, file, scene, preset, .. } = *self;
+        let span = c.span();
+        let c = c.get_ref();
+        let key = format!("claims.{}", c.figure);
+        if !ids.contains_key(&c.figure) {
+            let known: Vec<_> = ids.keys().map(String::as_str).collect();
+            return Err(loc.err(
+                span,
+                "claims.figure",
+                format!("no figure or table `{}` in this problem; its ids: {}", c.figure, known.join(", ")),
+            ));
+        }
+        for (what, text) in [("claim", &c.claim), ("source", &c.source)] {
+            if text.trim().is_empty() {
+                return Err(loc.err(span, &format!("{key}.{what}"), "is empty"));
+            }
+        }
+        let own = c.preset.as_deref().unwrap_or("paper");
+        if !file.presets.contains_key(own) {
+            let known: Vec<_> = file.presets.keys().map(String::as_str).collect();
+            return Err(loc.err(
+                span,
+                &format!("{key}.preset"),
+                format!("no preset `{own}`; this problem has: {}", known.join(", ")),
+            ));
+        }
+        let t = c.test.get_ref();
+        let tspan = c.test.span();
+        check_metric(loc, tspan.clone(), &format!("{key}.test.metric"), scene, &t.metric)?;
+        let bound = t.max.is_some() || t.min.is_some();
+        let monotone = t.decreasing.is_some() || t.increasing.is_some();
+        let compare = t.lower.is_some() || t.higher.is_some();
+        if [bound, monotone, compare].iter().filter(|x| **x).count() != 1
+            || (t.decreasing.is_some() && t.increasing.is_some())
+        {
+            return Err(loc.err(
+                tspan,
+                &format!("{key}.test"),
+                "a test is one of: `max` and/or `min`; `decreasing` or `increasing` (a parameter); `lower` with `higher` (and an optional `factor`)",
+            ));
+        }
+        if t.factor.is_some() && !compare {
+            return Err(loc.err(
+                tspan,
+                &format!("{key}.test.factor"),
+                "`factor` goes with `lower` and `higher`",
+            ));
+        }
+        if let (Some(lo), Some(hi)) = (t.min, t.max) {
+            if lo > hi {
+                return Err(loc.err(
+                    tspan,
+                    &format!("{key}.test"),
+                    format!("min = {lo} is above max = {hi}"),
+                ));
+            }
+        }
+        let select = self.select(&c.cases, &c.where_)?;
+        let picked = select.pick(cases);
+        if picked.is_empty() {
+            if preset != own {
+                return Ok(None);
+            }
+            nonempty(loc, span, &key, &select, cases, preset)?;
+        }
+        let test = if bound {
+            Test::Bound { metric: t.metric.clone(), max: t.max, min: t.min }
+        } else if monotone {
+            let (param, decreasing) = match (&t.decreasing, &t.increasing) {
+                (Some(p), _) => (p.clone(), true),
+                (None, Some(p)) => (p.clone(), false),
+                _ => unreachable!("checked above"),
+            };
+            self.parameter(tspan.clone(), &format!("{key}.test"), "decreasing/increasing", &param)?;
+            // Two values of the parameter among cases alike in the others, in the preset the
+            // claim is stated at: else there is no trend to judge.
+            if preset == own && !has_trend(&picked, &param) {
+                return Err(loc.err(
+                    tspan,
+                    &format!("{key}.test"),
+                    format!("no two selected cases differ in `{param}` alone in preset `{own}`: no trend to judge"),
+                ));
+            }
+            Test::Monotone { metric: t.metric.clone(), param, decreasing }
+        } else {
+            let (Some(lo), Some(hi)) = (&t.lower, &t.higher) else {
+                return Err(loc.err(tspan, &format!("{key}.test"), "`lower` and `higher` go together"));
+            };
+            let lower = self.select(&lo.cases, &lo.where_)?;
+            let higher = self.select(&hi.cases, &hi.where_)?;
+            if preset == own {
+                for (what, s) in [("lower", &lower), ("higher", &higher)] {
+                    let within: Vec<Case> =
+                        picked.iter().filter(|c| s.matches(c)).map(|c| (*c).clone()).collect();
+                    if within.is_empty() {
+                        return Err(loc.err(
+                            tspan.clone(),
+                            &format!("{key}.test.{what}"),
+                            format!("selects no case of the claim's selection in preset `{own}`"),
+                        ));
+                    }
+                }
+            }
+            let factor = t.factor.unwrap_or(1.0);
+            if !(factor.is_finite() && factor > 0.0) {
+                return Err(loc.err(
+                    tspan,
+                    &format!("{key}.test.factor"),
+                    format!("`{factor}` is not a positive ratio"),
+                ));
+            }
+            Test::LowerThan { metric: t.metric.clone(), lower, higher, factor }
+        };
+        Ok(Some(ClaimTest { select, test }))
+    }
+}
+
+/// Whether two of `cases` differ in `param` and in nothing else.
+pub(crate) fn has_trend(cases: &[&Case], param: &str) -> bool {
+    cases.iter().enumerate().any(|(i, a)| {
+        cases[i + 1..].iter().any(|b| {
+            a.params.0.get(param) != b.params.0.get(param)
+                && a.params.0.iter().all(|(k, v)| k == param || b.params.0.get(k) == Some(v))
+        })
+    })
+}
+
+/// The manuscript keys of a figure or table (`number`, `paper_caption`, `section`, `caption`,
+/// `discussion`), checked: a number the manuscript can order, and the paper's caption with it.
+fn item_info(
+    loc: &Loc,
+    span: Span,
+    key: &str,
+    (number, paper_caption, section, caption, discussion): (
+        &Option<String>,
+        &Option<String>,
+        &Option<String>,
+        &String,
+        &String,
+    ),
+) -> Result<ItemInfo, String> {
+    if let Some(n) = number {
+        if !papers::valid_number(n) {
+            return Err(loc.err(
+                span,
+                &format!("{key}.number"),
+                format!("`{n}`: a number is `Fig. N` or `Table N`, with an optional panel (`Fig. 14a`, `Fig. 13 (left)`)"),
+            ));
+        }
+        if paper_caption.as_deref().is_none_or(|c| c.trim().is_empty()) {
+            return Err(loc.err(
+                span,
+                &format!("{key}.paper_caption"),
+                "a numbered item needs the paper's caption in our words",
+            ));
+        }
+    } else if paper_caption.is_some() || section.is_some() {
+        let k = if paper_caption.is_some() { "paper_caption" } else { "section" };
+        return Err(loc.err(span, &format!("{key}.{k}"), "only an item with the paper's `number` takes it"));
+    }
+    Ok(ItemInfo {
+        number: number.clone(),
+        paper_caption: paper_caption.clone().unwrap_or_default(),
+        section: section.clone(),
+        caption: caption.clone(),
+        discussion: discussion.clone(),
+    })
 }
 
 /// Takes `id` for a figure or a table: a name their files can carry (it becomes
@@ -427,6 +655,10 @@ mod tests {
         let e = p(&kind("stability", "\nx = \"nx\"")).unwrap_err();
         assert!(e.contains("kind `stability` needs `max`"), "{e}");
         assert!(p(&kind("stability", "\nx = \"nx\"\nmax = 0.1")).is_ok());
+        // Two cases in one cell of the map (nx = 16: SPST and EDAC, no `label` to part them).
+        let e = p(&kind("stability", "\nx = \"nx\"\nmax = 0.1").replace("cases = [\"sun-*\"]\n", ""))
+            .unwrap_err();
+        assert!(e.contains("fall in one cell of the map") && e.contains("`scheme`"), "{e}");
         let e = p(&kind("particles", "")).unwrap_err();
         assert!(e.contains("needs `field`"), "{e}");
         assert!(p(&kind("particles", "\nfield = \"p\"\ntime = 0.01")).is_ok());

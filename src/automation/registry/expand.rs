@@ -3,7 +3,7 @@
 //! group's grid expanded into one case per combination (like automan's `mdict`/`dprod`),
 //! named from the group's template, and the same simulation under two names run once.
 
-use super::model::{valid_name, Case, Problem, MAX_CASES};
+use super::model::{valid_name, Case, Claim, Problem, MAX_CASES};
 use super::schema::{Loc, ProblemFile, RawParams, Span};
 use crate::scenes::params::{Params, Spec, Value};
 use crate::scenes::{self, SceneEntry};
@@ -91,8 +91,9 @@ pub(super) struct Expand<'a> {
 }
 
 impl Expand<'_> {
-    /// The problem `name` in this preset: its cases, then its figures, tables and bounds,
-    /// each checked against the scene and the cases.
+    /// The problem `name` in this preset: its cases, then its figures, tables, bounds and
+    /// claims, each checked against the scene and the cases (a claim's `at` holds this preset
+    /// when its selection picks a case here).
     pub(super) fn problem(&self, name: &str) -> Result<Problem, String> {
         let file = self.file;
         let cases = self.cases()?;
@@ -107,10 +108,25 @@ impl Expand<'_> {
             .iter()
             .filter_map(|b| self.bound(b, &cases).transpose())
             .collect::<Result<Vec<_>, _>>()?;
+        let mut claims = Vec::new();
+        for c in &file.claims {
+            let at = self.claim(c, &cases, &ids)?;
+            let raw = c.get_ref();
+            claims.push(Claim {
+                figure: raw.figure.clone(),
+                claim: raw.claim.clone(),
+                preset: raw.preset.clone().unwrap_or_else(|| "paper".into()),
+                source: raw.source.clone(),
+                line: self.loc.line(c.span().start),
+                at: at.map(|t| BTreeMap::from([(self.preset.to_string(), t)])).unwrap_or_default(),
+            });
+        }
         Ok(Problem {
             name: name.to_string(),
             path: self.loc.path.to_path_buf(),
             title: file.title.clone(),
+            paper: file.paper.get_ref().clone(),
+            section: file.section.clone(),
             description: file.description.clone(),
             scene: self.scene,
             preset: self.preset.to_string(),
@@ -119,6 +135,7 @@ impl Expand<'_> {
             figures,
             tables,
             bounds,
+            claims,
         })
     }
 
@@ -294,9 +311,9 @@ mod tests {
     #[test]
     fn case_errors_name_file_line_and_key() {
         let e = p(&GOOD.replace("pst = \"sun\"", "pst = \"warp\"")).unwrap_err();
-        assert!(e.starts_with("x.toml:14:") && e.contains("pst"), "{e}");
+        assert!(e.starts_with("x.toml:15:") && e.contains("pst"), "{e}");
         let e = p(&GOOD.replace("pst = \"sun\" }", "pst = \"sun\", frob = 1 }")).unwrap_err();
-        assert!(e.contains("frob") && e.contains(":14:"), "{e}");
+        assert!(e.contains("frob") && e.contains(":15:"), "{e}");
         let e = p(&GOOD.replace("nx = 16 }", "nx = 1.5 }")).unwrap_err();
         assert!(e.contains("nx") && e.contains("integer"), "{e}");
         let dup =

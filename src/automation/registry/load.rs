@@ -4,6 +4,7 @@
 use super::expand::Expand;
 use super::model::{valid_name, Problem, DEFAULT_PRESET};
 use super::schema::{Loc, ProblemFile};
+use crate::automation::papers;
 use crate::scenes;
 use std::path::{Path, PathBuf};
 
@@ -62,6 +63,7 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
             path.display()
         ));
     }
+    papers::find(file.paper.get_ref()).map_err(|e| loc.err(file.paper.span(), "paper", e))?;
     let specs = (scene.params)();
     if !file.presets.contains_key(DEFAULT_PRESET) {
         return Err(format!("{}: no [presets.{DEFAULT_PRESET}] (the default preset)", path.display()));
@@ -82,10 +84,12 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
             }
         }
     }
-    let (mut out, mut others) = (None, Vec::new());
+    let (mut out, mut others, mut claims_at, mut figures_at) = (None, Vec::new(), Vec::new(), Vec::new());
     for (pname, vars) in &file.presets {
         let x = Expand { loc: &loc, file: &file, scene, specs: &specs, preset: pname, vars: vars.get_ref() };
         let p = x.problem(&name)?;
+        claims_at.push(p.claims.iter().map(|c| c.at.clone()).collect::<Vec<_>>());
+        figures_at.push(p.figures.iter().map(|f| f.select_at.clone()).collect::<Vec<_>>());
         if pname == preset {
             out = Some(p);
         } else {
@@ -97,6 +101,31 @@ pub fn parse(path: &Path, src: &str, preset: &str) -> Result<Problem, String> {
         format!("{}: no preset `{preset}`; this problem has: {}", path.display(), known.join(", "))
     })?;
     problem.other_presets = others;
+    // Each claim resolved in every preset, so that a verdict can be drawn from another
+    // resolution when the claim's own has no results.
+    for at in claims_at {
+        for (c, a) in problem.claims.iter_mut().zip(at) {
+            c.at.extend(a);
+        }
+    }
+    for at in figures_at {
+        for (f, a) in problem.figures.iter_mut().zip(at) {
+            f.select_at.extend(a);
+        }
+    }
+    // The paper's section of every numbered item: its own or the problem's.
+    let numbered = problem
+        .figures
+        .iter()
+        .map(|f| (&f.id, &f.info))
+        .chain(problem.tables.iter().map(|t| (&t.id, &t.info)))
+        .find(|(_, i)| i.number.is_some() && i.section.is_none());
+    if let (Some((id, _)), None) = (numbered, &problem.section) {
+        return Err(format!(
+            "{}: `{id}` has the paper's `number` but neither it nor the problem names the paper's `section`",
+            path.display()
+        ));
+    }
     // What the scene would refuse at build time (a support that reaches no neighbour, a
     // resolution this machine cannot hold, ...), found before anything runs; for the preset
     // asked for only, since the others may be meant for a larger machine.

@@ -5,10 +5,10 @@
 //!
 //! - `schema`: the TOML schema, as written (serde structs with their spans);
 //! - `model`: the resolved problem the rest of the crate uses ([`Problem`], [`Case`],
-//!   [`Figure`], [`Table`], [`Bound`], [`Select`]);
+//!   [`Figure`], [`Table`], [`Bound`], [`Claim`], [`Select`]);
 //! - `load`: reading a file or a folder of them ([`load_dir`], [`load`], [`parse`]);
 //! - `expand`: presets and grids expanded into named cases;
-//! - `checks`: figures, tables and bounds checked against the scene and the cases;
+//! - `checks`: figures, tables, bounds and claims checked against the scene and the cases;
 //! - `reference`: the published points a `profile` figure is drawn against.
 
 mod checks;
@@ -20,7 +20,8 @@ mod schema;
 
 pub use load::{load, load_dir, parse};
 pub use model::{
-    glob_matches, Bound, Case, Figure, FigureKind, Problem, Reference, Select, Table, DEFAULT_PRESET,
+    glob_matches, Bound, Case, Claim, ClaimTest, Figure, FigureKind, ItemInfo, Problem, Reference, Select,
+    Table, Test, DEFAULT_PRESET,
 };
 pub use reference::reference_dir;
 

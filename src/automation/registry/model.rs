@@ -28,7 +28,7 @@ pub struct Case {
 
 /// Which cases a figure, table or bound is about: names (globs) and parameter values; a
 /// case is selected when it matches one of the globs (or there are none) and every value.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Select {
     /// Globs over case names (empty: every case).
     pub cases: Vec<String>,
@@ -115,8 +115,11 @@ pub enum FigureKind {
         x: String,
         /// Column on the vertical axis.
         y: String,
-        /// Published points drawn as markers.
-        reference: Option<Reference>,
+        /// Published points drawn as markers (one set per entry).
+        references: Vec<Reference>,
+        /// Curves drawn only over the horizontal range of the published points (`x_range =
+        /// "reference"`), e.g. a toe position over the time range of the experiment.
+        clip_to_reference: bool,
     },
 }
 
@@ -138,6 +141,21 @@ pub struct Reference {
     pub y: Vec<f64>,
 }
 
+/// Where a figure or a table sits in the manuscript and what it says beside it.
+#[derive(Clone, Debug, Default)]
+pub struct ItemInfo {
+    /// The paper's number for it (`Fig. 14a`, `Table 1`); `None`: beyond the paper.
+    pub number: Option<String>,
+    /// The paper's caption, in our words (numbered items).
+    pub paper_caption: String,
+    /// The paper's section it belongs to when not the problem's (`3.4 Free-surface ...`).
+    pub section: Option<String>,
+    /// Our caption: what our figure or table shows.
+    pub caption: String,
+    /// What is learnt from it (Markdown, present tense), after the verdicts.
+    pub discussion: String,
+}
+
 /// A figure a problem regenerates.
 #[derive(Clone, Debug)]
 pub struct Figure {
@@ -147,12 +165,13 @@ pub struct Figure {
     pub kind: FigureKind,
     /// Title.
     pub title: String,
-    /// Caption in the manuscript.
-    pub caption: String,
-    /// What the paper shows, for the manuscript's comparison line.
-    pub paper: String,
+    /// Its place and text in the manuscript.
+    pub info: ItemInfo,
     /// Cases drawn.
     pub select: Select,
+    /// Its selection resolved in every preset of the file (by name), e.g. for a stability
+    /// map's table of every preset.
+    pub select_at: BTreeMap<String, Select>,
     /// X-axis label (with units; `profile` only).
     pub x_label: Option<String>,
     /// Y-axis label (with units).
@@ -163,10 +182,6 @@ pub struct Figure {
     pub metric: Option<String>,
     /// Parameters naming each curve (or each row of a stability map).
     pub label: Vec<String>,
-    /// The paper's claim: the metric decreases as the last `label` parameter grows.
-    pub converges: bool,
-    /// The paper's claim: the `lower` cases have a smaller metric than the `higher` ones.
-    pub lower_than: Option<(Select, Select)>,
 }
 
 /// A table of summary values.
@@ -176,8 +191,8 @@ pub struct Table {
     pub id: String,
     /// Title.
     pub title: String,
-    /// Caption.
-    pub caption: String,
+    /// Its place and text in the manuscript.
+    pub info: ItemInfo,
     /// Rows.
     pub select: Select,
     /// Parameter columns.
@@ -203,6 +218,81 @@ pub struct Bound {
     pub line: usize,
 }
 
+/// A claim of the paper on one of a problem's figures or tables, checked as a test on the
+/// summaries' metrics at a preset.
+#[derive(Clone, Debug)]
+pub struct Claim {
+    /// The id of the figure or table it is judged on.
+    pub figure: String,
+    /// The paper's claim, in our words.
+    pub claim: String,
+    /// The preset whose results judge it (the resolution it is stated at).
+    pub preset: String,
+    /// Where the tolerance (or the qualitative test) comes from.
+    pub source: String,
+    /// Line in the problem file.
+    pub line: usize,
+    /// Its selection and test resolved in every preset where the selection picks a case
+    /// (by preset name; always holds `preset`).
+    pub at: BTreeMap<String, ClaimTest>,
+}
+
+/// A claim's selection and test, resolved in one preset.
+#[derive(Clone, Debug)]
+pub struct ClaimTest {
+    /// The cases it is judged on.
+    pub select: Select,
+    /// The test.
+    pub test: Test,
+}
+
+/// What a claim tests.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Test {
+    /// `metric` within `[min, max]` in every selected case.
+    Bound {
+        /// Metric.
+        metric: String,
+        /// Largest value that meets the claim.
+        max: Option<f64>,
+        /// Smallest value that meets the claim.
+        min: Option<f64>,
+    },
+    /// `metric` falls (or grows) strictly as `param` grows, in every group of selected
+    /// cases alike in their other parameters.
+    Monotone {
+        /// Metric.
+        metric: String,
+        /// The parameter along which it is monotone.
+        param: String,
+        /// Falls (`true`) or grows.
+        decreasing: bool,
+    },
+    /// The mean of `metric` over the `lower` cases is at most `factor` times its mean over
+    /// the `higher` ones (both within the claim's selection).
+    LowerThan {
+        /// Metric.
+        metric: String,
+        /// The cases the paper finds better.
+        lower: Select,
+        /// The cases they are compared with.
+        higher: Select,
+        /// The ratio the claim allows (1: lower or equal).
+        factor: f64,
+    },
+}
+
+impl Test {
+    /// The metric tested.
+    pub fn metric(&self) -> &str {
+        match self {
+            Test::Bound { metric, .. } | Test::Monotone { metric, .. } | Test::LowerThan { metric, .. } => {
+                metric
+            }
+        }
+    }
+}
+
 /// A problem: one paper benchmark, with its cases expanded for one preset.
 #[derive(Clone)]
 pub struct Problem {
@@ -212,6 +302,11 @@ pub struct Problem {
     pub path: PathBuf,
     /// Title.
     pub title: String,
+    /// The paper it belongs to (a key of [`papers::PAPERS`](crate::automation::papers::PAPERS)).
+    pub paper: String,
+    /// The paper's section its numbered figures and tables belong to (`4.1 Taylor-Green
+    /// vortex`), unless an item names its own.
+    pub section: Option<String>,
     /// Description (Markdown), for the manuscript.
     pub description: String,
     /// Scene.
@@ -229,6 +324,22 @@ pub struct Problem {
     pub tables: Vec<Table>,
     /// Bounds that apply to this preset.
     pub bounds: Vec<Bound>,
+    /// The paper's claims, each resolved in every preset.
+    pub claims: Vec<Claim>,
+}
+
+impl Problem {
+    /// The cases of every preset, this one first: `(preset, cases)`.
+    pub fn presets(&self) -> Vec<(&str, &[Case])> {
+        let mut v = vec![(self.preset.as_str(), self.cases.as_slice())];
+        v.extend(self.other_presets.iter().map(|(n, c)| (n.as_str(), c.as_slice())));
+        v
+    }
+
+    /// The cases of preset `name`, if the problem has it.
+    pub fn cases_of(&self, name: &str) -> Option<&[Case]> {
+        self.presets().into_iter().find(|(n, _)| *n == name).map(|(_, c)| c)
+    }
 }
 
 impl std::fmt::Debug for Problem {

@@ -116,7 +116,10 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         let root = with_reference("y,Re100,Re400\n0.0,0.0,0.0\n0.5,-0.2,-0.1\n1.0,1.0,1.0\n");
         let pr = p_in(root.path(), &format!("{GOOD}{PROFILE}")).unwrap();
         let f = pr.figures.iter().find(|f| f.id == "prof").unwrap();
-        let FigureKind::Profile { file, x, y, reference: Some(r) } = &f.kind else { panic!("{:?}", f.kind) };
+        let FigureKind::Profile { file, x, y, references, clip_to_reference: false } = &f.kind else {
+            panic!("{:?}", f.kind)
+        };
+        let r = &references[0];
         assert_eq!((file.as_str(), x.as_str(), y.as_str()), ("centerline_u.csv", "u", "y"));
         assert_eq!(r.x, [0.0, -0.2, 1.0]);
         assert_eq!(r.y, [0.0, 0.5, 1.0]);
@@ -126,11 +129,27 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         // Without a reference, and with the default label (the file stem).
         let bare = PROFILE.replace(", label = \"Ghia et al. 1982\"", "");
         let pr = p_in(root.path(), &format!("{GOOD}{bare}")).unwrap();
-        let FigureKind::Profile { reference: Some(r), .. } = &pr.figures[1].kind else { panic!() };
-        assert_eq!(r.label, "ref");
+        let FigureKind::Profile { references, .. } = &pr.figures[1].kind else { panic!() };
+        assert_eq!(references[0].label, "ref");
         let none = bare.lines().filter(|l| !l.starts_with("reference")).collect::<Vec<_>>().join("\n");
         let pr = p_in(root.path(), &format!("{GOOD}{none}")).unwrap();
-        assert!(matches!(pr.figures[1].kind, FigureKind::Profile { reference: None, .. }));
+        assert!(
+            matches!(&pr.figures[1].kind, FigureKind::Profile { references, .. } if references.is_empty())
+        );
+        // Two sets of points, and the curves clipped to their range.
+        let two = PROFILE.replace(
+            "reference = { file = \"ref.csv\", x = \"Re100\", y = \"y\", label = \"Ghia et al. 1982\" }",
+            "reference = [{ file = \"ref.csv\", x = \"Re100\", y = \"y\" }, { file = \"ref.csv\", x = \"Re400\", y = \"y\" }]\nx_range = \"reference\"",
+        );
+        let pr = p_in(root.path(), &format!("{GOOD}{two}")).unwrap();
+        let FigureKind::Profile { references, clip_to_reference, .. } = &pr.figures[1].kind else { panic!() };
+        assert_eq!((references.len(), references[1].x[1], *clip_to_reference), (2, -0.1, true));
+        let e = p_in(
+            root.path(),
+            &format!("{GOOD}{}", two.replace("x_range = \"reference\"", "x_range = \"all\"")),
+        )
+        .unwrap_err();
+        assert!(e.contains("figures.prof.x_range") && e.contains("`all`"), "{e}");
         // reference_data/ sits next to the problems folder.
         assert_eq!(reference_dir(Path::new("problems/a.toml")), Path::new("reference_data"));
         assert_eq!(reference_dir(Path::new("/r/problems/a.toml")), Path::new("/r/reference_data"));

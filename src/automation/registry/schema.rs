@@ -17,6 +17,9 @@ pub(super) type RawParams = BTreeMap<String, Spanned<toml::Value>>;
 pub(super) struct ProblemFile {
     pub(super) title: String,
     pub(super) scene: Spanned<String>,
+    pub(super) paper: Spanned<String>,
+    #[serde(default)]
+    pub(super) section: Option<String>,
     #[serde(default)]
     pub(super) description: String,
     #[serde(default)]
@@ -31,6 +34,8 @@ pub(super) struct ProblemFile {
     pub(super) tables: Vec<Spanned<TableFile>>,
     #[serde(default)]
     pub(super) bounds: Vec<Spanned<BoundFile>>,
+    #[serde(default)]
+    pub(super) claims: Vec<Spanned<ClaimFile>>,
 }
 
 /// A `[[cases]]` group: fixed parameters, a grid of lists expanded into one case per
@@ -65,9 +70,15 @@ pub(super) struct FigureFile {
     pub(super) kind: String,
     pub(super) title: String,
     #[serde(default)]
+    pub(super) number: Option<String>,
+    #[serde(default)]
+    pub(super) paper_caption: Option<String>,
+    #[serde(default)]
+    pub(super) section: Option<String>,
+    #[serde(default)]
     pub(super) caption: String,
     #[serde(default)]
-    pub(super) paper: String,
+    pub(super) discussion: String,
     #[serde(default)]
     pub(super) cases: Vec<String>,
     #[serde(default, rename = "where")]
@@ -99,15 +110,29 @@ pub(super) struct FigureFile {
     #[serde(default)]
     pub(super) x_label: Option<String>,
     #[serde(default)]
-    pub(super) reference: Option<Spanned<ReferenceFile>>,
+    pub(super) reference: Option<Spanned<OneOrMany<ReferenceFile>>>,
+    #[serde(default)]
+    pub(super) x_range: Option<String>,
     #[serde(default)]
     pub(super) max: Option<f64>,
-    #[serde(default)]
-    pub(super) converges: bool,
-    #[serde(default)]
-    pub(super) lower: Option<SelectFile>,
-    #[serde(default)]
-    pub(super) higher: Option<SelectFile>,
+}
+
+/// One value or a list of them (`reference = {...}` or `reference = [{...}, {...}]`).
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(super) enum OneOrMany<T> {
+    One(T),
+    Many(Vec<T>),
+}
+
+impl<T> OneOrMany<T> {
+    /// The values, in order.
+    pub(super) fn as_slice(&self) -> &[T] {
+        match self {
+            OneOrMany::One(t) => std::slice::from_ref(t),
+            OneOrMany::Many(v) => v,
+        }
+    }
 }
 
 /// Published points a `profile` figure is drawn against: two columns of a CSV file in
@@ -129,7 +154,15 @@ pub(super) struct TableFile {
     pub(super) id: String,
     pub(super) title: String,
     #[serde(default)]
+    pub(super) number: Option<String>,
+    #[serde(default)]
+    pub(super) paper_caption: Option<String>,
+    #[serde(default)]
+    pub(super) section: Option<String>,
+    #[serde(default)]
     pub(super) caption: String,
+    #[serde(default)]
+    pub(super) discussion: String,
     #[serde(default)]
     pub(super) cases: Vec<String>,
     #[serde(default, rename = "where")]
@@ -154,6 +187,46 @@ pub(super) struct BoundFile {
     pub(super) min: Option<f64>,
     #[serde(default)]
     pub(super) presets: Option<Vec<String>>,
+}
+
+/// A `[[claims]]` entry: the paper's claim on one of the problem's figures or tables, as a
+/// test on metrics at a preset.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ClaimFile {
+    pub(super) figure: String,
+    pub(super) claim: String,
+    #[serde(default)]
+    pub(super) preset: Option<String>,
+    #[serde(default)]
+    pub(super) cases: Vec<String>,
+    #[serde(default, rename = "where")]
+    pub(super) where_: RawParams,
+    pub(super) test: Spanned<TestFile>,
+    pub(super) source: String,
+}
+
+/// The test of a claim: a bound on every selected case (`max`, `min`), a monotone trend
+/// along a parameter (`decreasing`, `increasing`), or one selection's mean below another's
+/// (`lower`, `higher`, `factor`).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct TestFile {
+    pub(super) metric: String,
+    #[serde(default)]
+    pub(super) max: Option<f64>,
+    #[serde(default)]
+    pub(super) min: Option<f64>,
+    #[serde(default)]
+    pub(super) decreasing: Option<String>,
+    #[serde(default)]
+    pub(super) increasing: Option<String>,
+    #[serde(default)]
+    pub(super) lower: Option<SelectFile>,
+    #[serde(default)]
+    pub(super) higher: Option<SelectFile>,
+    #[serde(default)]
+    pub(super) factor: Option<f64>,
 }
 
 /// A byte range of a problem file, where an error points.

@@ -8,6 +8,7 @@ use std::path::Path;
 pub(super) const GOOD: &str = r#"
 title = "t"
 scene = "taylor_green"
+paper = "ctvf"
 [params]
 tf = "$tf"
 [presets.quick]

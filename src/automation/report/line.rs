@@ -32,7 +32,8 @@ pub enum SeriesStyle {
     Points,
     /// Solid line with markers at the data points.
     LinePoints,
-    /// Black square markers: published reference points.
+    /// Black markers: published reference points (squares; a second set triangles, a third
+    /// diamonds).
     Reference,
 }
 
@@ -51,6 +52,9 @@ pub struct LineFigure {
     pub log_y: bool,
     /// The curves, drawn in order.
     pub series: Vec<Series>,
+    /// The data ranges to show, `[x0, x1, y0, y1]` (the panels of one figure share them);
+    /// `None` fits the curves.
+    pub extent: Option<[f64; 4]>,
 }
 
 /// Writes `fig` to `<stem>.png` and `<stem>.svg` (900 x 600 pixels): labelled axes,
@@ -91,14 +95,21 @@ impl Render for LineFigure {
     }
 
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let xs = self.series.iter().flat_map(|s| s.x.iter().copied());
-        let ys = self.series.iter().flat_map(|s| s.y.iter().copied());
-        let (x, y) = (Axis::fit(xs, self.log_x), Axis::fit(ys, self.log_y));
+        let (x, y) = match self.extent {
+            Some([x0, x1, y0, y1]) => (Axis::fit([x0, x1], self.log_x), Axis::fit([y0, y1], self.log_y)),
+            None => {
+                let xs = self.series.iter().flat_map(|s| s.x.iter().copied());
+                let ys = self.series.iter().flat_map(|s| s.y.iter().copied());
+                (Axis::fit(xs, self.log_x), Axis::fit(ys, self.log_y))
+            }
+        };
         let runs = self.runs(&x, &y);
         let mut chart = canvas::chart(area, x.clone(), y.clone())?;
         canvas::mesh(&mut chart, &self.x_label, &self.y_label, true)?;
 
         let mut colour_index = 0;
+        // Each set of published points its own marker: squares, then triangles, diamonds.
+        let mut reference_index = 0;
         for (s, runs) in self.series.iter().zip(&runs) {
             let dashed = s.style == SeriesStyle::Dashed;
             let reference = s.style == SeriesStyle::Reference;
@@ -112,7 +123,12 @@ impl Render for LineFigure {
             let with_line = !matches!(s.style, SeriesStyle::Points | SeriesStyle::Reference);
             let with_marks =
                 matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints | SeriesStyle::Reference);
-            let mark = if reference { 2 } else { 0 };
+            let mark = if reference {
+                reference_index += 1;
+                [2, 1, 3, 4][(reference_index - 1) % 4]
+            } else {
+                0
+            };
             for (k, run) in runs.iter().enumerate() {
                 let anno = if dashed {
                     chart.draw_series(DashedLineSeries::new(run.iter().copied(), 10, 6, line))
@@ -156,6 +172,7 @@ mod tests {
             y_label: "L2 velocity error [m/s]".into(),
             log_x: log,
             log_y: log,
+            extent: None,
             series: vec![
                 Series {
                     label: "EDAC".into(),
@@ -209,6 +226,7 @@ mod tests {
             y_label: "E_k / E_k(0)".into(),
             log_x: false,
             log_y: false,
+            extent: None,
             series: vec![
                 Series {
                     label: "exact".into(),

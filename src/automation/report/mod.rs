@@ -23,7 +23,7 @@ mod particles;
 mod table;
 
 pub use line::{line_figure, LineFigure, Series, SeriesStyle};
-pub use manuscript::{write_manuscript, Item, Manuscript, Section};
+pub use manuscript::{write_manuscript, Block, Item, Manuscript, Part, Section};
 pub use map::{outcome_map, Outcome, OutcomeMap};
 pub use order::observed_order;
 pub use pareto::{pareto_figure, pareto_front, ParetoFigure};

@@ -1,5 +1,6 @@
-//! Particle figures: particles as dots coloured by a field, with a colour bar, and an
-//! optional vector field (e.g. free-surface normals) drawn as short segments.
+//! Particle figures: particles as dots coloured by a field, with a colour bar, the walls'
+//! particles in grey, and an optional vector field (e.g. free-surface normals) drawn as
+//! arrows.
 
 use super::canvas::{self, Axis, Render, MARGIN, X_LABEL_AREA, Y_LABEL_AREA};
 use super::colors::viridis;
@@ -27,6 +28,15 @@ pub struct ScatterField {
     pub value: Vec<f64>,
     /// Colour bar label, with units.
     pub value_label: String,
+    /// Axis labels, with units (`x (m)`).
+    pub x_label: String,
+    /// Axis labels, with units (`y (m)`).
+    pub y_label: String,
+    /// Wall particles (x, y), drawn in grey under the fluid.
+    pub walls: Option<(Vec<f64>, Vec<f64>)>,
+    /// The data extent `[x0, x1, y0, y1]` to show (the panels of one figure share one);
+    /// `None` fits the particles and walls.
+    pub extent: Option<[f64; 4]>,
     /// Colour scale limits; `None` fits the finite values. Values outside are clamped.
     pub range: Option<(f64, f64)>,
     /// Same length scale on both axes (the data ranges are widened to fit the canvas).
@@ -36,36 +46,78 @@ pub struct ScatterField {
     pub arrows: Option<Arrows>,
 }
 
-/// A vector point array drawn as segments of one length (direction only) at the
-/// particles where it is non-zero and finite.
+/// A vector point array drawn as arrows of one length (direction only) at the particles
+/// where it is non-zero and finite.
 #[derive(Clone, Debug)]
 pub struct Arrows {
     /// x components, one per particle.
     pub u: Vec<f64>,
     /// y components, one per particle.
     pub v: Vec<f64>,
-    /// Segment length in data units; `None`: the typical particle spacing (median
-    /// nearest-neighbour distance).
+    /// Arrow length in data units; `None`: one and a half particle spacings (the median
+    /// nearest-neighbour distance), and at least [`MIN_ARROW_PX`] pixels.
     pub length: Option<f64>,
 }
 
-/// Colour of the vector segments (red: distinct from the viridis dots).
+/// Colour of the arrows (red: distinct from the viridis dots).
 const ARROW: RGBColor = RGBColor(215, 48, 39);
+/// Colour of the wall particles.
+const WALL: RGBColor = RGBColor(150, 150, 150);
+/// The shortest arrow drawn, in pixels: shorter ones cannot be seen.
+pub const MIN_ARROW_PX: f64 = 14.0;
 
 impl Arrows {
-    /// The segments `(start, end)` in data units over particles at `x`, `y`.
-    pub(crate) fn segments(&self, x: &[f64], y: &[f64]) -> Vec<((f64, f64), (f64, f64))> {
-        let len = self.length.unwrap_or_else(|| typical_spacing(x, y));
+    /// The arrows `(start, end)` in data units over particles at `x`, `y`, `length` long;
+    /// where particles stand closer than `0.6 length`, one arrow per such distance (the
+    /// first in particle order), so that arrows do not pile on each other.
+    pub(crate) fn layout(&self, x: &[f64], y: &[f64], length: f64) -> Vec<((f64, f64), (f64, f64))> {
         let n = x.len().min(y.len()).min(self.u.len()).min(self.v.len());
-        (0..n)
-            .filter_map(|i| {
-                let (u, v) = (self.u[i], self.v[i]);
-                let norm = u.hypot(v);
-                (norm > 0.0 && norm.is_finite() && x[i].is_finite() && y[i].is_finite())
-                    .then(|| ((x[i], y[i]), (x[i] + len * u / norm, y[i] + len * v / norm)))
-            })
-            .collect()
+        let gap = 0.6 * length;
+        let mut taken: std::collections::HashMap<(i64, i64), Vec<(f64, f64)>> =
+            std::collections::HashMap::new();
+        let mut out = Vec::new();
+        for i in 0..n {
+            let (u, v) = (self.u[i], self.v[i]);
+            let norm = u.hypot(v);
+            if !(norm > 0.0 && norm.is_finite() && x[i].is_finite() && y[i].is_finite()) {
+                continue;
+            }
+            let cell = ((x[i] / gap).floor() as i64, (y[i] / gap).floor() as i64);
+            let near = (-1..=1).any(|a| {
+                (-1..=1).any(|b| {
+                    taken.get(&(cell.0 + a, cell.1 + b)).is_some_and(|pts| {
+                        pts.iter().any(|p| (p.0 - x[i]).hypot(p.1 - y[i]) < gap * (1.0 - 1e-9))
+                    })
+                })
+            });
+            if near {
+                continue;
+            }
+            taken.entry(cell).or_default().push((x[i], y[i]));
+            out.push(((x[i], y[i]), (x[i] + length * u / norm, y[i] + length * v / norm)));
+        }
+        out
     }
+
+    /// How many particles have an arrow to draw (non-zero, finite).
+    pub fn count(&self) -> usize {
+        self.u
+            .iter()
+            .zip(&self.v)
+            .filter(|(a, b)| a.hypot(**b) > 0.0 && a.is_finite() && b.is_finite())
+            .count()
+    }
+}
+
+/// The polyline of an arrow from `p` to `q`: the shaft, then the two barbs of its head
+/// (a third of its length, 25 degrees off the shaft).
+fn arrow_path(p: (f64, f64), q: (f64, f64)) -> Vec<(f64, f64)> {
+    let (dx, dy) = (q.0 - p.0, q.1 - p.1);
+    let barb = |sign: f64| {
+        let (c, s) = (25f64.to_radians().cos(), sign * 25f64.to_radians().sin());
+        (q.0 - (dx * c - dy * s) / 3.0, q.1 - (dx * s + dy * c) / 3.0)
+    };
+    vec![p, q, barb(1.0), q, barb(-1.0)]
 }
 
 /// The median distance from a particle to its nearest neighbour (1 for fewer than two
@@ -136,6 +188,29 @@ pub fn particle_figure(f: &ScatterField, stem: &Path) -> Result<(), String> {
 }
 
 impl ScatterField {
+    /// The arrows' length in data units: as asked, or one and a half particle spacings and
+    /// at least [`MIN_ARROW_PX`] pixels of the plotting area (taken at its size below the
+    /// title, about 50 pixels, so that the count below and the drawing agree).
+    fn arrow_length(&self, a: &Arrows) -> f64 {
+        if let Some(l) = a.length {
+            return l;
+        }
+        let (w, h) = self.size();
+        let pw = (w - BAR_PANEL).saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1) as f64;
+        let ph = (h - 50).saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1) as f64;
+        let (x, y) = self.axes(pw, ph);
+        let (xr, yr) = (x.range(), y.range());
+        let per_px = ((xr.end - xr.start) / pw).max((yr.end - yr.start) / ph);
+        let n = self.x.len().min(self.y.len());
+        (1.5 * typical_spacing(&self.x[..n], &self.y[..n])).max(MIN_ARROW_PX * per_px)
+    }
+
+    /// The arrows drawn: `(drawn, particles with a vector)`.
+    pub fn arrows_drawn(&self) -> (usize, usize) {
+        let Some(a) = &self.arrows else { return (0, 0) };
+        (a.layout(&self.x, &self.y, self.arrow_length(a)).len(), a.count())
+    }
+
     fn value_range(&self) -> (f64, f64) {
         let (lo, hi) = self.range.unwrap_or_else(|| {
             self.value
@@ -155,7 +230,15 @@ impl ScatterField {
     /// Axes fitted to the positions; with `aspect_equal`, widened so one data unit has
     /// the same length in pixels on both axes of a `w` x `h` plotting area.
     fn axes(&self, w: f64, h: f64) -> (Axis, Axis) {
-        let (x, y) = (Axis::fit(self.x.iter().copied(), false), Axis::fit(self.y.iter().copied(), false));
+        let (x, y) = match self.extent {
+            Some([x0, x1, y0, y1]) => (Axis::fit([x0, x1], false), Axis::fit([y0, y1], false)),
+            None => {
+                let walls = self.walls.as_ref();
+                let xs = self.x.iter().chain(walls.into_iter().flat_map(|w| w.0.iter())).copied();
+                let ys = self.y.iter().chain(walls.into_iter().flat_map(|w| w.1.iter())).copied();
+                (Axis::fit(xs, false), Axis::fit(ys, false))
+            }
+        };
         if !self.aspect_equal {
             return (x, y);
         }
@@ -185,22 +268,36 @@ impl Render for ScatterField {
         let ph = h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1) as f64;
         let (x, y) = self.axes(pw, ph);
         let (lo, hi) = self.value_range();
+        // Data units per pixel (the larger of the two axes' when they differ).
+        let per_px = {
+            let (xr, yr) = (x.range(), y.range());
+            ((xr.end - xr.start) / pw).max((yr.end - yr.start) / ph)
+        };
         let mut chart = canvas::chart(&main, x, y)?;
-        canvas::mesh(&mut chart, "x", "y", false)?;
+        canvas::mesh(&mut chart, &self.x_label, &self.y_label, false)?;
 
         let n = self.x.len().min(self.y.len()).min(self.value.len());
-        // Dots about a third of the mean spacing, as if the particles filled the plot.
-        let r = ((pw * ph / n.max(1) as f64).sqrt() * 0.35).clamp(1.0, 6.0).round() as i32;
+        // Dots as wide as the particle spacing, so that a fluid reads as one.
+        let spacing = typical_spacing(&self.x[..n], &self.y[..n]);
+        let r = (0.55 * spacing / per_px).clamp(1.0, 6.0).round() as i32;
+        if let Some((wx, wy)) = &self.walls {
+            let walls = wx.iter().zip(wy).filter(|(a, b)| a.is_finite() && b.is_finite());
+            chart
+                .draw_series(walls.map(|(a, b)| Circle::new((*a, *b), r, WALL.filled())))
+                .map_err(|e| e.to_string())?;
+        }
         let dots = (0..n).filter(|&i| self.x[i].is_finite() && self.y[i].is_finite()).map(|i| {
             let c = viridis((self.value[i] - lo) / (hi - lo));
             Circle::new((self.x[i], self.y[i]), r, c.filled())
         });
         chart.draw_series(dots).map_err(|e| e.to_string())?;
         if let Some(a) = &self.arrows {
-            let segs = a.segments(&self.x, &self.y);
+            let arrows = a.layout(&self.x, &self.y, self.arrow_length(a));
             chart
                 .draw_series(
-                    segs.into_iter().map(|(p, q)| PathElement::new(vec![p, q], ARROW.stroke_width(1))),
+                    arrows
+                        .into_iter()
+                        .map(|(p, q)| PathElement::new(arrow_path(p, q), ARROW.stroke_width(2))),
                 )
                 .map_err(|e| e.to_string())?;
         }
@@ -273,12 +370,16 @@ mod tests {
             y,
             value: p,
             value_label: "p [Pa]".into(),
+            x_label: "x (m)".into(),
+            y_label: "y (m)".into(),
+            walls: None,
+            extent: None,
             range: None,
             aspect_equal: true,
             arrows: None,
         };
         particle_figure(&f, &stem).unwrap();
-        check_figure(&stem, (900, 720), &["Taylor-Green pressure, t = 2 s", "p [Pa]"]);
+        check_figure(&stem, (900, 720), &["Taylor-Green pressure, t = 2 s", "p [Pa]", "x (m)", "y (m)"]);
         let (x, y) = f.axes(600.0, 300.0);
         let (xr, yr) = (x.range(), y.range());
         let ratio = ((xr.end - xr.start) / 600.0) / ((yr.end - yr.start) / 300.0);
@@ -298,6 +399,10 @@ mod tests {
                 y: vec![0.0, 1.0, 0.5],
                 value: vec![-hi, hi, 0.0],
                 value_label: "p [Pa]".into(),
+                x_label: "x (m)".into(),
+                y_label: "y (m)".into(),
+                walls: None,
+                extent: None,
                 range: None,
                 aspect_equal: false,
                 arrows: None,
@@ -319,6 +424,10 @@ mod tests {
             y: vec![0.0, 0.0],
             value: vec![3.0, 3.0],
             value_label: "rho [kg/m^3]".into(),
+            x_label: "x (m)".into(),
+            y_label: "y (m)".into(),
+            walls: None,
+            extent: None,
             range: Some((2.0, 4.0)),
             aspect_equal: false,
             arrows: None,
@@ -329,10 +438,11 @@ mod tests {
         assert_eq!(empty.value_range(), (0.0, 1.0));
     }
 
-    /// A ring of particles with outward normals on its outer layer: one red segment per
-    /// non-zero normal, one particle spacing long, in both PNG and SVG.
+    /// A ring of particles with outward normals on its outer layer, in a box of wall
+    /// particles: one red arrow (shaft and head) per non-zero normal, one and a half particle
+    /// spacings long, the walls in grey, in both PNG and SVG.
     #[test]
-    fn normals_drawn_as_segments_where_non_zero() {
+    fn normals_drawn_as_arrows_where_non_zero() {
         let dir = tempfile::tempdir().unwrap();
         let stem = dir.path().join("ring_normals");
         let dx = 0.05;
@@ -354,27 +464,40 @@ mod tests {
         let spacing = typical_spacing(&x, &y);
         assert!((spacing - dx).abs() < 0.2 * dx, "{spacing}");
         let arrows = Arrows { u, v, length: None };
-        let segs = arrows.segments(&x, &y);
-        assert_eq!(segs.len(), outer);
-        for ((x0, y0), (x1, y1)) in &segs {
-            assert!(((x1 - x0).hypot(y1 - y0) - spacing).abs() < 1e-12);
-            assert!(x1.hypot(*y1) > x0.hypot(*y0)); // outward
-        }
+        let walls: (Vec<f64>, Vec<f64>) = (0..40).map(|i| (-1.0 + i as f64 * dx, -1.0)).unzip();
         let f = ScatterField {
             title: "ring: free surface and normals".into(),
             x,
             y,
             value: fs,
             value_label: "free_surface".into(),
+            x_label: "x (m)".into(),
+            y_label: "y (m)".into(),
+            walls: Some(walls),
+            extent: None,
             range: None,
             aspect_equal: true,
             arrows: Some(arrows),
         };
+        let a = f.arrows.as_ref().unwrap();
+        let len = f.arrow_length(a);
+        assert!((len - 1.5 * spacing).abs() < 1e-12, "{len}");
+        let segs = a.layout(&f.x, &f.y, len);
+        assert_eq!(segs.len(), outer);
+        for ((x0, y0), (x1, y1)) in &segs {
+            assert!(((x1 - x0).hypot(y1 - y0) - len).abs() < 1e-12);
+            assert!(x1.hypot(*y1) > x0.hypot(*y0)); // outward
+        }
+        assert_eq!(f.arrows_drawn(), (outer, outer));
         particle_figure(&f, &stem).unwrap();
         let svg = check_figure(&stem, (900, 720), &["ring: free surface and normals", "free_surface"]);
         let red = svg.matches("stroke=\"#D73027\"").count();
-        assert_eq!(red, outer, "one segment per non-zero normal");
-        // Without the overlay, no segment.
+        assert_eq!(red, outer, "one arrow per non-zero normal");
+        assert!(svg.contains("#969696"), "the walls in grey");
+        // Arrows closer than 0.6 of their length are thinned; the count says how many.
+        let short = Arrows { length: Some(10.0 * spacing), ..f.arrows.clone().unwrap() };
+        assert!(short.layout(&f.x, &f.y, 10.0 * spacing).len() < outer / 4);
+        // Without the overlay, no arrow.
         particle_figure(&ScatterField { arrows: None, ..f }, &stem).unwrap();
         let svg = std::fs::read_to_string(stem.with_extension("svg")).unwrap();
         assert_eq!(svg.matches("stroke=\"#D73027\"").count(), 0);

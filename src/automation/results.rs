@@ -1,0 +1,256 @@
+//! The committed results: `results/` next to the problems folder (for `--problems DIR`,
+//! `DIR/../results`), laid out as the output folder (`results/<problem>/<case>-<key>/`),
+//! and read by the cache as a second, read-only layer ([`Entry`](super::cache::Entry)): a
+//! case whose folder there holds a finished summary is done, so a fresh clone runs nothing
+//! that was committed, and the paper preset's manuscript is drawn from these results alone
+//! (so that it is the same on every clone).
+//!
+//! [`export`] copies the finished cases of the paper preset from the output folder into it:
+//! `case.json`, `summary.json`, `timeseries.csv`, the files the problem's profile figures read
+//! (e.g. `centerline_u.csv`), and only the snapshots its particle figures draw, gzip-compressed
+//! (`vtu/fluid_00012.vtu.gz`, with a `fluid.pvd` / `wall.pvd` listing them under the names they
+//! have once uncompressed). Where a claim's paper-preset results are missing, the summaries of
+//! its cases at the other presets go too (for the verdict drawn there), and so do those of
+//! the stability maps at the other presets (for their first-failure tables): those folders
+//! hold a [`SUMMARY_ONLY`] file and are not done cases for the cache. The folder is kept
+//! under [`BUDGET`] bytes: past it, the largest snapshots are dropped (named), and the figures
+//! that draw them say so.
+
+use super::cache::{self, Entry};
+use super::registry::{FigureKind, Problem};
+use super::study::snapshot::{pick_snapshot, pvd_entries, pvd_text};
+use crate::solver::output::summary::{Status, Summary};
+use std::collections::{BTreeMap, BTreeSet};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// The preset whose results are committed (and whose manuscript is).
+pub const EXPORT_PRESET: &str = "paper";
+
+/// The size the committed results keep under, in bytes.
+pub const BUDGET: u64 = 50_000_000;
+
+/// The file that marks a committed case folder holding only its summary (a case of another
+/// preset, exported for a verdict or a stability table): it is read by the paper preset's
+/// manuscript, and is not a done case for the cache (the case's figures need more).
+pub const SUMMARY_ONLY: &str = "SUMMARY_ONLY";
+
+const SUMMARY_ONLY_TEXT: &str =
+    "Only case.json and summary.json of this case are committed: the paper preset's \
+manuscript reads them (a verdict drawn at this case's preset, a stability table). The cache \
+does not take the case as done; `sphrepro run` computes it whole.\n";
+
+/// The committed results' folder of `problem`: `results/` beside its problems folder (`None`
+/// for a file given without a folder).
+pub fn root(problem: &Problem) -> Option<PathBuf> {
+    root_of(problem.path.parent()?)
+}
+
+/// The committed results' folder beside the problems folder `problems`.
+pub fn root_of(problems: &Path) -> Option<PathBuf> {
+    let parent = problems.parent()?;
+    Some(parent.join("results"))
+}
+
+/// What an export did.
+#[derive(Debug, Default)]
+pub struct Exported {
+    /// Cases exported with their files.
+    pub cases: usize,
+    /// Cases of other presets exported with their summary only.
+    pub summaries: usize,
+    /// Snapshots written.
+    pub snapshots: usize,
+    /// The size of the results folder after it, in bytes.
+    pub bytes: u64,
+    /// Snapshots dropped to keep under the budget: (file, bytes).
+    pub dropped: Vec<(PathBuf, u64)>,
+    /// Folders of earlier inputs (matching no case of any preset), per problem: read by
+    /// nothing; remove them with `git rm` to keep the folder small.
+    pub earlier: Vec<(String, usize)>,
+}
+
+fn finished(dir: &Path) -> bool {
+    Summary::read(dir).is_ok_and(|s| matches!(s.status, Status::Completed | Status::Diverged))
+}
+
+/// Writes `bytes` to `path` unless it holds them already.
+fn put(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    if std::fs::read(path).is_ok_and(|b| b == bytes) {
+        return Ok(());
+    }
+    if let Some(d) = path.parent() {
+        std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
+    }
+    crate::solver::output::write_atomic(path, bytes).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Copies `names` from `from` to `to` (those that exist).
+fn copy(from: &Path, to: &Path, names: &[&str]) -> Result<(), String> {
+    for n in names {
+        let src = from.join(n);
+        if src.exists() {
+            let bytes = std::fs::read(&src).map_err(|e| format!("{}: {e}", src.display()))?;
+            put(&to.join(n), &bytes)?;
+        }
+    }
+    Ok(())
+}
+
+/// `bytes` gzip-compressed (no time stamp in the header: the same bytes every time).
+fn gzip(bytes: &[u8]) -> Result<Vec<u8>, String> {
+    let mut enc = flate2::GzBuilder::new().mtime(0).write(Vec::new(), flate2::Compression::best());
+    enc.write_all(bytes).map_err(|e| e.to_string())?;
+    enc.finish().map_err(|e| e.to_string())
+}
+
+/// Exports the finished cases of the [`EXPORT_PRESET`] of `problems` (loaded for it) from
+/// `output` into their committed-results folders (see the module doc).
+pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
+    let mut out = Exported::default();
+    let mut roots = BTreeSet::new();
+    for p in problems.iter().filter(|p| p.preset == EXPORT_PRESET) {
+        let Some(root) = root(p) else { continue };
+        roots.insert(root.clone());
+        let dest = |e: &Entry| root.join(&p.name).join(e.record.folder());
+        let entries = cache::entries(output, p);
+        // Every finished case, with the files its figures read.
+        for e in entries.iter().filter(|e| finished(&e.dir)) {
+            let mut names = vec!["case.json", "summary.json", "timeseries.csv"];
+            for f in p.figures.iter().filter(|f| f.select.matches(&e.case)) {
+                if let FigureKind::Profile { file, .. } = &f.kind {
+                    if !names.contains(&file.as_str()) {
+                        names.push(file);
+                    }
+                }
+            }
+            copy(&e.dir, &dest(e), &names)?;
+            let _ = std::fs::remove_file(dest(e).join(SUMMARY_ONLY));
+            out.cases += 1;
+        }
+        // The snapshots the particle figures draw: of the first selected case with a result,
+        // the one nearest the figure's time, and the walls' nearest it.
+        let mut snaps: BTreeMap<PathBuf, (PathBuf, BTreeSet<String>, BTreeSet<String>)> = BTreeMap::new();
+        for f in &p.figures {
+            let FigureKind::Particles { time, .. } = &f.kind else { continue };
+            let drawn = f
+                .select
+                .pick(&p.cases)
+                .into_iter()
+                .map(|c| Entry::new(output, p, c))
+                .find(|e| finished(&dest(e)) || finished(&e.dir));
+            let Some(e) = drawn.filter(|e| finished(&e.dir)) else { continue };
+            let list = pvd_entries(&e.dir, "fluid.pvd")?;
+            let (t, file) = pick_snapshot(&list, *time).clone();
+            let slot =
+                snaps.entry(e.dir.clone()).or_insert_with(|| (dest(&e), BTreeSet::new(), BTreeSet::new()));
+            slot.1.insert(file);
+            if e.dir.join("wall.pvd").exists() {
+                let walls = pvd_entries(&e.dir, "wall.pvd")?;
+                slot.2.insert(pick_snapshot(&walls, Some(t)).1.clone());
+            }
+        }
+        for (from, (to, fluid, wall)) in snaps {
+            for (series, files) in [("fluid.pvd", &fluid), ("wall.pvd", &wall)] {
+                if files.is_empty() {
+                    continue;
+                }
+                let list: Vec<(f64, String)> =
+                    pvd_entries(&from, series)?.into_iter().filter(|(_, f)| files.contains(f)).collect();
+                for (_, f) in &list {
+                    let src = from.join(f);
+                    let bytes = std::fs::read(&src).map_err(|e| format!("{}: {e}", src.display()))?;
+                    put(&to.join(format!("{f}.gz")), &gzip(&bytes)?)?;
+                    out.snapshots += 1;
+                }
+                put(&to.join(series), pvd_text(&list).as_bytes())?;
+            }
+            // Snapshots of an earlier export that no figure draws now.
+            let keep: BTreeSet<PathBuf> =
+                fluid.iter().chain(&wall).map(|f| to.join(format!("{f}.gz"))).collect();
+            if let Ok(rd) = std::fs::read_dir(to.join("vtu")) {
+                for old in rd.flatten().map(|e| e.path()) {
+                    if old.extension().is_some_and(|x| x == "gz") && !keep.contains(&old) {
+                        let _ = std::fs::remove_file(&old);
+                    }
+                }
+            }
+        }
+        // Summaries of the other presets: where a claim's paper-preset results are missing,
+        // those of its cases elsewhere; and those of the stability maps.
+        let mut lite: BTreeSet<PathBuf> = BTreeSet::new();
+        for c in &p.claims {
+            let complete = c.at.get(EXPORT_PRESET).is_some_and(|ct| {
+                ct.select.pick(&p.cases).iter().all(|case| finished(&dest(&Entry::new(output, p, case))))
+            });
+            if complete {
+                continue;
+            }
+            for (preset, ct) in c.at.iter().filter(|(k, _)| k.as_str() != EXPORT_PRESET) {
+                for case in p.cases_of(preset).map(|cs| ct.select.pick(cs)).unwrap_or_default() {
+                    lite.insert(Entry::new(output, p, case).dir);
+                }
+            }
+        }
+        for f in p.figures.iter().filter(|f| matches!(f.kind, FigureKind::Stability { .. })) {
+            for (preset, cases) in p.presets() {
+                if let (true, Some(select)) = (preset != EXPORT_PRESET, f.select_at.get(preset)) {
+                    lite.extend(select.pick(cases).into_iter().map(|c| Entry::new(output, p, c).dir));
+                }
+            }
+        }
+        for dir in lite.iter().filter(|d| finished(d)) {
+            let to = root.join(&p.name).join(dir.file_name().expect("a case folder"));
+            if finished(&to) && !to.join(SUMMARY_ONLY).exists() {
+                continue; // committed whole already (a case of the paper preset too)
+            }
+            copy(dir, &to, &["case.json", "summary.json"])?;
+            put(&to.join(SUMMARY_ONLY), SUMMARY_ONLY_TEXT.as_bytes())?;
+            out.summaries += 1;
+        }
+        // Folders of earlier inputs.
+        let live: Vec<PathBuf> = p
+            .presets()
+            .into_iter()
+            .flat_map(|(_, cases)| {
+                cases.iter().map(|c| root.join(&p.name).join(cache::CaseRecord::new(&p.name, c).folder()))
+            })
+            .collect();
+        let earlier = cache::stale_folders(&root, &p.name, &live).len();
+        if earlier > 0 {
+            out.earlier.push((p.name.clone(), earlier));
+        }
+    }
+    // The budget: drop the largest snapshots until the folder fits.
+    for root in roots {
+        let mut files = Vec::new();
+        walk(&root, &mut files);
+        let mut total: u64 = files.iter().map(|(_, n)| n).sum();
+        let mut snaps: Vec<(PathBuf, u64)> =
+            files.into_iter().filter(|(f, _)| f.to_string_lossy().ends_with(".vtu.gz")).collect();
+        snaps.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+        for (f, n) in snaps {
+            if total <= BUDGET {
+                break;
+            }
+            std::fs::remove_file(&f).map_err(|e| format!("{}: {e}", f.display()))?;
+            total -= n;
+            out.dropped.push((f, n));
+        }
+        out.bytes += total;
+    }
+    Ok(out)
+}
+
+/// Every file under `dir`, with its size.
+fn walk(dir: &Path, out: &mut Vec<(PathBuf, u64)>) {
+    let Ok(rd) = std::fs::read_dir(dir) else { return };
+    for e in rd.flatten() {
+        let p = e.path();
+        if p.is_dir() {
+            walk(&p, out);
+        } else if let Ok(m) = e.metadata() {
+            out.push((p, m.len()));
+        }
+    }
+}

@@ -1,0 +1,464 @@
+//! Verdicts on the paper's claims: each claim of a problem file is a test on the summaries'
+//! metrics at a preset ([`Test`]); its verdict is `reproduced`, `not reproduced` (with each
+//! case's number against the test) or `not run` (results missing at that preset, with an
+//! estimate of what they would cost). When the claim's own preset has no results and another
+//! preset does, the verdict there is given too, labelled as drawn at that resolution.
+
+use super::words;
+use super::{fmt_bound, fmt_value, param_f64};
+use crate::automation::cache::Entry;
+use crate::automation::registry::{Case, Claim, Problem, Select, Test};
+use crate::solver::output::summary::{Status, Summary};
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// What became of a claim at one preset.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// The test holds.
+    Reproduced,
+    /// The test fails (the numbers say by how much).
+    NotReproduced,
+    /// Results are missing at that preset.
+    NotRun,
+}
+
+impl Verdict {
+    /// The verdict in words.
+    pub fn word(self) -> &'static str {
+        match self {
+            Verdict::Reproduced => "reproduced",
+            Verdict::NotReproduced => "not reproduced",
+            Verdict::NotRun => "not run",
+        }
+    }
+}
+
+/// A claim judged at one preset.
+#[derive(Clone, Debug)]
+pub struct Judgement {
+    /// The verdict.
+    pub verdict: Verdict,
+    /// The preset whose results judged it.
+    pub preset: String,
+    /// The numbers (or the missing cases and their estimated cost), as a sentence.
+    pub detail: String,
+}
+
+/// A claim with its verdict at its own preset and, when that is `not run`, at another.
+#[derive(Clone, Debug)]
+pub struct ClaimVerdict {
+    /// The claim.
+    pub claim: Claim,
+    /// At the claim's preset.
+    pub own: Judgement,
+    /// At another preset with results, when the claim's own has none.
+    pub other: Option<Judgement>,
+}
+
+impl ClaimVerdict {
+    /// The verdict as a Markdown paragraph: the claim, the source of its tolerance, the
+    /// verdict and its numbers.
+    pub fn markdown(&self) -> String {
+        let mut s = format!(
+            "**Claim:** {} *Test, {}:* {}. *Source:* {}\n\n**Verdict: {}** {}: {}",
+            end_sentence(&self.claim.claim),
+            at_words(&self.own.preset),
+            describe(&self.claim, &self.own.preset),
+            end_sentence(&self.claim.source),
+            self.own.verdict.word(),
+            at_words(&self.own.preset),
+            self.own.detail
+        );
+        if let Some(o) = &self.other {
+            s += &format!(" {}: {}, {}", capitalise(&at_words(&o.preset)), o.verdict.word(), o.detail);
+        }
+        s
+    }
+
+    /// The verdict in a few words, for the summary table.
+    pub fn short(&self) -> String {
+        let mut s = match self.own.verdict {
+            Verdict::NotReproduced => format!("**{}**", self.own.verdict.word()),
+            v => v.word().to_string(),
+        };
+        if self.own.preset != "paper" {
+            s += &format!(" (`{}` preset)", self.own.preset);
+        }
+        if let Some(o) = &self.other {
+            s += &format!("; `{}` preset: {}", o.preset, o.verdict.word());
+        }
+        s
+    }
+}
+
+fn capitalise(s: &str) -> String {
+    let mut c = s.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().chain(c).collect(),
+        None => String::new(),
+    }
+}
+
+fn end_sentence(s: &str) -> String {
+    let t = s.trim();
+    if t.ends_with(['.', '!', '?']) {
+        t.to_string()
+    } else {
+        format!("{t}.")
+    }
+}
+
+/// "at the paper's resolutions (`paper` preset)" or "at the `quick` preset, not the paper's
+/// resolutions".
+fn at_words(preset: &str) -> String {
+    if preset == "paper" {
+        "at the paper's resolutions (`paper` preset)".into()
+    } else {
+        format!("at the `{preset}` preset, not the paper's resolutions")
+    }
+}
+
+/// The test of `claim` at `preset` in words.
+fn describe(claim: &Claim, preset: &str) -> String {
+    let Some(ct) = claim.at.get(preset).or_else(|| claim.at.get(&claim.preset)) else {
+        return "none".into();
+    };
+    match &ct.test {
+        Test::Bound { metric, max, min } => match (min, max) {
+            (Some(lo), Some(hi)) => {
+                format!("{} <= `{metric}` <= {} in every case", fmt_bound(*lo), fmt_bound(*hi))
+            }
+            (None, Some(hi)) => format!("`{metric}` <= {} in every case", fmt_bound(*hi)),
+            (Some(lo), None) => format!("`{metric}` >= {} in every case", fmt_bound(*lo)),
+            (None, None) => format!("`{metric}`"),
+        },
+        Test::Monotone { metric, param, decreasing } => {
+            format!("`{metric}` {} strictly as `{param}` grows", if *decreasing { "falls" } else { "grows" })
+        }
+        Test::LowerThan { metric, lower, higher, factor } => {
+            let side = |s: &Select| {
+                let w: Vec<String> =
+                    s.where_.iter().map(|(k, v)| words::phrase(k, v)).filter(|p| !p.is_empty()).collect();
+                if w.is_empty() {
+                    format!("cases {}", s.cases.join(", "))
+                } else {
+                    w.join(", ")
+                }
+            };
+            let times = if *factor == 1.0 { String::new() } else { format!("{factor} x ") };
+            format!(
+                "`{metric}` ({}) <= {times}`{metric}` ({}), each the mean over its cases",
+                side(lower),
+                side(higher)
+            )
+        }
+    }
+}
+
+/// One case's outcome for a metric.
+enum Outcome {
+    Value(f64),
+    Diverged(f64, String),
+    NoMetric,
+    Missing,
+}
+
+fn outcome(entry: &Entry, metric: &str) -> Outcome {
+    match entry.summary() {
+        Some(s) if s.status == Status::Diverged => {
+            Outcome::Diverged(s.final_time, s.reason.unwrap_or_default())
+        }
+        Some(s) if s.status == Status::Completed => {
+            s.metrics.get(metric).copied().map(Outcome::Value).unwrap_or(Outcome::NoMetric)
+        }
+        _ => Outcome::Missing,
+    }
+}
+
+/// The parameters that tell `cases` apart, in the order the first case lists them (its
+/// resolution when they are alike).
+fn distinguishing(cases: &[&Case]) -> Vec<String> {
+    let Some(first) = cases.first() else { return Vec::new() };
+    let keys: Vec<String> = first
+        .params
+        .0
+        .keys()
+        .filter(|k| cases.iter().any(|c| c.params.0.get(*k) != first.params.0.get(*k)))
+        .cloned()
+        .collect();
+    if !keys.is_empty() {
+        return keys;
+    }
+    ["nx", "dx"].iter().filter(|k| first.params.0.contains_key(**k)).map(|k| k.to_string()).take(1).collect()
+}
+
+/// Judges every claim of `p` from the results under `output` (and the committed ones).
+pub fn judge_all(p: &Problem, output: &Path) -> Vec<ClaimVerdict> {
+    p.claims.iter().map(|c| judge(p, c, output)).collect()
+}
+
+/// Judges `claim` at its preset and, if `not run` there, at the first other preset (this
+/// run's first) whose selection has every result.
+pub fn judge(p: &Problem, claim: &Claim, output: &Path) -> ClaimVerdict {
+    let own = judge_at(p, claim, &claim.preset, output);
+    let other = (own.verdict == Verdict::NotRun)
+        .then(|| {
+            p.presets()
+                .into_iter()
+                .map(|(name, _)| name)
+                .filter(|name| *name != claim.preset && claim.at.contains_key(*name))
+                .map(|name| judge_at(p, claim, name, output))
+                .find(|j| j.verdict != Verdict::NotRun)
+        })
+        .flatten();
+    ClaimVerdict { claim: claim.clone(), own, other }
+}
+
+/// Judges `claim` at `preset`.
+pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judgement {
+    let j = |verdict, detail: String| Judgement { verdict, preset: preset.to_string(), detail };
+    let (Some(ct), Some(cases)) = (claim.at.get(preset), p.cases_of(preset)) else {
+        return j(Verdict::NotRun, format!("the claim selects no case of the `{preset}` preset."));
+    };
+    let picked = ct.select.pick(cases);
+    let keys = distinguishing(&picked);
+    let name = |c: &Case| words::label(c, &keys);
+    let metric = ct.test.metric();
+    let results: Vec<(&Case, Outcome)> =
+        picked.iter().map(|c| (*c, outcome(&Entry::new(output, p, c), metric))).collect();
+    let missing: Vec<&Case> =
+        results.iter().filter(|(_, v)| matches!(v, Outcome::Missing)).map(|(c, _)| *c).collect();
+    if !missing.is_empty() {
+        let list: Vec<String> = missing
+            .iter()
+            .map(|c| {
+                let est = estimate(p, c, output).map(|e| format!(" ({e})")).unwrap_or_default();
+                format!("`{}`{est}", c.name)
+            })
+            .collect();
+        return j(
+            Verdict::NotRun,
+            format!("no result for {} of the {} case(s): {}.", missing.len(), picked.len(), list.join("; ")),
+        );
+    }
+    let show = |c: &Case, v: &Outcome| match v {
+        Outcome::Value(x) => format!("{}: {}", name(c), fmt_value(*x)),
+        Outcome::Diverged(t, why) => format!("{}: diverged at t = {t:.3} s ({why})", name(c)),
+        Outcome::NoMetric => format!("{}: no `{metric}`", name(c)),
+        Outcome::Missing => format!("{}: no result", name(c)),
+    };
+    match &ct.test {
+        Test::Bound { max, min, .. } => {
+            let mut ok = true;
+            let parts: Vec<String> = results
+                .iter()
+                .map(|(c, v)| match v {
+                    Outcome::Value(x) => {
+                        // NaN is over and under: a non-finite value passes no bound.
+                        let over = max.is_some_and(|m| x.is_nan() || *x > m);
+                        let under = min.is_some_and(|m| x.is_nan() || *x < m);
+                        ok &= !(over || under);
+                        let mark = if over {
+                            format!(" > {}", fmt_bound(max.unwrap()))
+                        } else if under {
+                            format!(" < {}", fmt_bound(min.unwrap()))
+                        } else {
+                            String::new()
+                        };
+                        format!("{}{mark}", show(c, v))
+                    }
+                    other => {
+                        ok = false;
+                        show(c, other)
+                    }
+                })
+                .collect();
+            j(
+                if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
+                format!("`{metric}` {}.", parts.join("; ")),
+            )
+        }
+        Test::Monotone { param, decreasing, .. } => {
+            // Groups of cases alike but in `param`, each sorted along it.
+            let mut groups: BTreeMap<String, Vec<(&Case, &Outcome)>> = BTreeMap::new();
+            for (c, v) in &results {
+                let key: Vec<String> =
+                    c.params.0.iter().filter(|(k, _)| *k != param).map(|(k, v)| format!("{k}={v}")).collect();
+                groups.entry(key.join(",")).or_default().push((c, v));
+            }
+            let group_keys: Vec<String> = keys.iter().filter(|k| *k != param).cloned().collect();
+            let mut ok = true;
+            let mut judged = 0;
+            let mut parts = Vec::new();
+            for g in groups.values_mut().filter(|g| g.len() >= 2) {
+                judged += 1;
+                g.sort_by(|a, b| param_f64(a.0, param).total_cmp(&param_f64(b.0, param)));
+                let mut text = String::new();
+                let mut prev: Option<f64> = None;
+                for (c, v) in g.iter() {
+                    let at = words::phrase(param, &c.params.0[param]);
+                    match v {
+                        Outcome::Value(x) => {
+                            if let Some(p0) = prev {
+                                let holds = if *decreasing { *x < p0 } else { *x > p0 };
+                                ok &= holds;
+                                text += if holds { " then " } else { " then (not monotone) " };
+                            }
+                            text += &format!("{at}: {}", fmt_value(*x));
+                            prev = Some(*x);
+                        }
+                        other => {
+                            ok = false;
+                            if !text.is_empty() {
+                                text += " then ";
+                            }
+                            text += &show(c, other);
+                            prev = None;
+                        }
+                    }
+                }
+                let head = if group_keys.is_empty() {
+                    String::new()
+                } else {
+                    format!("{}: ", words::label(g[0].0, &group_keys))
+                };
+                parts.push(format!("{head}{text}"));
+            }
+            if judged == 0 {
+                return j(
+                    Verdict::NotRun,
+                    format!("no two cases differ in `{param}` alone at this preset: no trend to judge."),
+                );
+            }
+            j(
+                if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
+                format!("`{metric}` {}.", parts.join("; ")),
+            )
+        }
+        Test::LowerThan { lower, higher, factor, .. } => {
+            let side = |s: &Select| -> (Option<f64>, Vec<String>, bool) {
+                let mut vals = Vec::new();
+                let mut notes = Vec::new();
+                let mut bad = false;
+                for (c, v) in results.iter().filter(|(c, _)| s.matches(c)) {
+                    match v {
+                        Outcome::Value(x) => vals.push(*x),
+                        other => {
+                            bad = true;
+                            notes.push(show(c, other));
+                        }
+                    }
+                }
+                let mean = (!vals.is_empty() && !bad).then(|| vals.iter().sum::<f64>() / vals.len() as f64);
+                (mean, notes, bad || vals.is_empty())
+            };
+            let describe_side = |s: &Select| -> String {
+                let cs: Vec<&Case> = results.iter().map(|(c, _)| *c).filter(|c| s.matches(c)).collect();
+                let k: Vec<String> = s.where_.keys().cloned().collect();
+                match cs.first() {
+                    Some(c) if !k.is_empty() => words::label(c, &k),
+                    _ => cs.iter().map(|c| c.name.clone()).collect::<Vec<_>>().join(", "),
+                }
+            };
+            let (a, an, abad) = side(lower);
+            let (b, bn, bbad) = side(higher);
+            let (la, lb) = (describe_side(lower), describe_side(higher));
+            match (a, b) {
+                (Some(a), Some(b)) if !abad && !bbad => {
+                    let ok = a <= factor * b;
+                    let ratio = if b != 0.0 { format!(" (ratio {:.2})", a / b) } else { String::new() };
+                    let bound = if *factor == 1.0 { String::new() } else { format!(" x {factor}") };
+                    j(
+                        if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
+                        format!(
+                            "`{metric}` {la}: {} {} {lb}: {}{bound}{ratio}.",
+                            fmt_value(a),
+                            if ok { "<=" } else { ">" },
+                            fmt_value(b)
+                        ),
+                    )
+                }
+                _ => {
+                    let notes: Vec<String> = an.into_iter().chain(bn).collect();
+                    j(Verdict::NotReproduced, format!("`{metric}` {}.", notes.join("; ")))
+                }
+            }
+        }
+    }
+}
+
+/// The parameters that set a case's size and length, and how its cost grows with each.
+const SIZE_KEYS: [&str; 4] = ["nx", "dx", "tf", "nz"];
+
+/// An estimate of what `case` would take, scaled from the most similar finished case of
+/// the problem (any preset, either layer): the fewest other differing parameters, then the
+/// nearest in size. Wall time grows as particles times steps: (nx ratio)^(dim + 1) or
+/// (dx ratio)^-(dim + 1), tf and nz linearly.
+pub fn estimate(p: &Problem, case: &Case, output: &Path) -> Option<String> {
+    let dim = p.scene.dim as i32;
+    let mut best: Option<(usize, f64, &Case, Summary)> = None;
+    for (_, cases) in p.presets() {
+        for c in cases {
+            if c.params == case.params {
+                continue;
+            }
+            let Some(s) = Entry::new(output, p, c).summary().filter(|s| s.status == Status::Completed) else {
+                continue;
+            };
+            let diffs = case
+                .params
+                .0
+                .iter()
+                .filter(|(k, v)| !SIZE_KEYS.contains(&k.as_str()) && c.params.0.get(*k) != Some(*v))
+                .count();
+            let scale = scale(case, c, dim);
+            let far = scale.ln().abs();
+            if best.as_ref().is_none_or(|b| (diffs, far) < (b.0, b.1)) {
+                best = Some((diffs, far, c, s));
+            }
+        }
+    }
+    let (_, _, c, s) = best?;
+    let secs = s.wall_seconds * scale(case, c, dim);
+    Some(format!(
+        "estimated {} on {} thread{}, scaled from `{}`, which took {}",
+        duration(secs),
+        s.threads,
+        if s.threads == 1 { "" } else { "s" },
+        c.name,
+        duration(s.wall_seconds)
+    ))
+}
+
+/// How much longer `a` runs than `b`, from their sizes.
+fn scale(a: &Case, b: &Case, dim: i32) -> f64 {
+    let ratio = |k: &str| -> Option<f64> {
+        let (x, y) = (param_f64(a, k), param_f64(b, k));
+        (x.is_finite() && y.is_finite() && x > 0.0 && y > 0.0).then(|| x / y)
+    };
+    let mut f = 1.0;
+    if let Some(r) = ratio("nx") {
+        f *= r.powi(dim + 1);
+    }
+    if let Some(r) = ratio("dx") {
+        f *= r.powi(-(dim + 1));
+    }
+    for k in ["tf", "nz"] {
+        if let Some(r) = ratio(k) {
+            f *= r;
+        }
+    }
+    f
+}
+
+/// A duration in the unit that reads best.
+pub(crate) fn duration(secs: f64) -> String {
+    if secs < 120.0 {
+        format!("{secs:.0} s")
+    } else if secs < 7200.0 {
+        format!("{:.0} min", secs / 60.0)
+    } else {
+        format!("{:.1} h", secs / 3600.0)
+    }
+}
