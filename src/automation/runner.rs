@@ -325,8 +325,16 @@ fn run_one(
             Err(err) => break Err(err),
         }
         if INTERRUPTED.load(Ordering::SeqCst) && !signalled {
-            // The terminal sends SIGINT to the child too; make sure it gets one.
-            let _ = Command::new("kill").args(["-INT", &child.id().to_string()]).status();
+            // Make sure the child stops with a checkpoint. Not SIGINT: the terminal may
+            // have sent it one already, and a second ends a run without its checkpoint;
+            // SIGUSR1 stops `simulate` with a checkpoint however often it comes.
+            #[cfg(unix)]
+            // SAFETY: kill has no memory-safety preconditions; the pid is our live child's.
+            unsafe {
+                libc::kill(child.id() as libc::pid_t, libc::SIGUSR1);
+            }
+            #[cfg(not(unix))]
+            let _ = child.kill();
             signalled = true;
         }
         if let Some((t, tf, left)) = std::fs::read_to_string(&progress).ok().as_deref().and_then(read_file) {
