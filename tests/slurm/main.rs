@@ -165,7 +165,7 @@ fn a_task_at_its_time_limit_is_requeued_and_resumes_from_its_checkpoint() {
     else {
         return;
     };
-    let problem = "title = \"slow\"\nscene = \"taylor_green\"\n[presets.quick]\n\
+    let problem = "title = \"slow\"\nscene = \"taylor_green\"\npaper = \"ctvf\"\n[presets.quick]\n\
                    [[cases]]\nname = \"a\"\nparams = { nx = 16, tf = 24.0 }\n";
     let (on_slurm, local) = (Env::new(problem, FAST, Some(&slurm)), Env::new(problem, FAST, None));
     let t0 = Instant::now();
@@ -209,7 +209,7 @@ fn a_case_whose_requeue_is_refused_is_submitted_again_and_resumes() {
     else {
         return;
     };
-    let problem = "title = \"slow\"\nscene = \"taylor_green\"\n[presets.quick]\n\
+    let problem = "title = \"slow\"\nscene = \"taylor_green\"\npaper = \"ctvf\"\n[presets.quick]\n\
                    [[cases]]\nname = \"a\"\nparams = { nx = 16, tf = 24.0 }\n";
     let env = Env::new(problem, FAST, Some(&slurm));
     let fake = tempfile::tempdir().unwrap();
@@ -518,7 +518,7 @@ fn a_real_time_limit_is_survived() {
     let Some(slurm) = cluster::start_or_skip("a_real_time_limit_is_survived") else {
         return;
     };
-    let problem = "title = \"slow\"\nscene = \"taylor_green\"\n[presets.quick]\n\
+    let problem = "title = \"slow\"\nscene = \"taylor_green\"\npaper = \"ctvf\"\n[presets.quick]\n\
                    [[cases]]\nname = \"a\"\nparams = { nx = 32, tf = 40.0 }\n";
     let env = Env::new(problem, &format!("{FAST}time = \"1\"\nsignal_before = 50\n"), Some(&slurm));
     let t0 = Instant::now();
