@@ -390,3 +390,64 @@ impl SceneRun for Plate {
         restore_sim(&mut self.sim, &state)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Eq. (67) vanishes with its slope at the clamp; the thin-plate period of the paper's
+    /// plate is Table 1's analytical 0.254 s; the period rule of the module's docs.
+    #[test]
+    fn mode_shape_theory_and_period_rule() {
+        let (l, k) = (0.2, KL / 0.2);
+        assert_eq!(mode_shape(0.0, k, l), 0.0);
+        assert!(mode_shape(1e-4, k, l).abs() < 1e-6 * mode_shape(l, k, l).abs(), "zero slope at x = 0");
+        let m = SolidMaterial::new(2.0e6, 0.3975, 1000.0).unwrap();
+        assert!((thin_plate_period(&m, 0.2, 0.02) - 0.254).abs() < 0.0005);
+        assert_eq!(period_from_crossings(&[]), None);
+        assert_eq!(period_from_crossings(&[0.1]), Some(0.2));
+        assert!((period_from_crossings(&[0.1, 0.2, 0.3]).unwrap() - 0.2).abs() < 1e-15);
+    }
+
+    /// The quick case (dx = 0.004, five particles across) through one period: no numerical
+    /// fracture (one cluster, no particle farther than 1.5 dx from its nearest neighbour),
+    /// and a period (two crossings) within 15 % of the thin-plate period (the coarse plate
+    /// is stiffer; the paper's periods are 12 % above it).
+    #[test]
+    fn the_quick_plate_oscillates_without_fracture() {
+        let specs = params();
+        let mut p = Params::defaults(&specs);
+        for (key, value) in [("dx", "0.004"), ("tf", "0.3")] {
+            p.set_str("oscillating_plate", &specs, key, value).unwrap();
+        }
+        let mut run = plate(&p).unwrap();
+        while run.sim.time() < 0.3 {
+            let before = run.sim.time();
+            run.advance(before + 0.01, 0.3, &mut |_, _| true).unwrap();
+            run.sample();
+        }
+        let m = run.metrics();
+        assert_eq!(m["clusters_max"], 1.0);
+        assert!(m["max_gap"] < LINK, "{m:?}");
+        assert_eq!(run.crossings.len(), 2, "{:?}", run.crossings);
+        assert!(m["period_rel_error_theory"] < 0.15, "{m:?}");
+        assert!(m.contains_key("period_rel_error_paper"));
+    }
+
+    /// Bad material input is refused with the key and value named.
+    #[test]
+    fn bad_material_is_refused_by_key() {
+        let specs = params();
+        for (key, value) in [("poisson_ratio", "0.5"), ("poisson_ratio", "-1"), ("poisson_ratio", "0.7")] {
+            let mut p = Params::defaults(&specs);
+            p.set_str("oscillating_plate", &specs, key, value).unwrap();
+            let e = setup(&p).err().unwrap();
+            assert!(e.contains(&format!("`{key}` = {value}")) || e.contains(&format!("`{key}` = {value}.0")), "{e}");
+        }
+        for (key, value) in [("youngs_modulus", "0"), ("density", "-1"), ("dx", "0")] {
+            let mut p = Params::defaults(&specs);
+            let e = p.set_str("oscillating_plate", &specs, key, value).unwrap_err();
+            assert!(e.contains(&format!("`{key}`")) && e.contains(value), "{e}");
+        }
+    }
+}

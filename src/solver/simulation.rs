@@ -562,7 +562,10 @@ impl<const D: usize> Simulation<D> {
                 Body::Wall(wall) if wall.moves() => cells.update(&wall.x),
                 Body::Wall(_) => {}
                 // A solid keeps its particles in the order given (no reordering).
-                Body::ElasticSolid(solid) => cells.update(&solid.x),
+                Body::ElasticSolid(solid) => {
+                    solid.x.iter_mut().for_each(|x| domain.wrap(x));
+                    cells.update(&solid.x)
+                }
             }
         }
     }

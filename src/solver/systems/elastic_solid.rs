@@ -297,7 +297,7 @@ mod tests {
         let s =
             ElasticSolid::new("plate", 0.1, init, SolidMaterial::new(1.0, 0.3, 1000.0).unwrap(), physics())
                 .unwrap();
-        assert_eq!(s.u[0], Vector::zeros());
+        assert_eq!(s.u[0], Vector::<2>::zeros());
         assert_eq!(s.u[1], Vector::<2>::new(1.0, 0.0));
         assert_eq!(s.u_hat.as_ref().unwrap().len(), 2);
         let bad = SolidInit { fixed: vec![false], ..SolidInit::<2>::default() };
