@@ -60,6 +60,9 @@ const PAPER_PLATE: (f64, f64, f64, f64, f64) = (0.2, 0.02, 2.0e6, 0.3975, 1000.0
 /// The body's name.
 const PLATE: &str = "plate";
 
+/// The most steps a run may need (as the fluid scenes' bound).
+const MAX_STEPS: f64 = 1e9;
+
 /// The registry entry.
 pub const ENTRY: SceneEntry = SceneEntry {
     name: "oscillating_plate",
@@ -134,20 +137,44 @@ fn setup(p: &Params) -> Result<Setup, String> {
             "must lie in (-1, 0.5): at 0.5 the bulk modulus is infinite, at -1 the shear modulus".into(),
         );
     }
+    if p.float("vf") >= 1.0 {
+        return bad("vf", "must be below 1: the tip would start at the speed of sound".into());
+    }
     let material = SolidMaterial::new(p.float("youngs_modulus"), nu, p.float("density"))
         .map_err(|e| format!("scene `{scene}`: {e}"))?;
     let dx = p.float("dx");
     let (l, hp) = (p.float("length"), p.float("height"));
-    let (nx, ny) = ((l / dx).round() as usize, (hp / dx).round() as usize);
-    if ny < 2 || nx < 4 {
-        return bad("dx", format!("too coarse for a plate of {l} x {hp} m: at least 4 x 2 particles"));
+    // In floating point first: a spacing of 1e-300 m must not overflow a count.
+    let (nxf, nyf) = ((l / dx).round(), (hp / dx).round());
+    let plate = format!("the plate (`length` = {l:?}, `height` = {hp:?}) at `dx` = {dx:?}");
+    if nyf < 2.0 || nxf < 4.0 {
+        return Err(format!("scene `{scene}`: {plate} has fewer than 4 x 2 particles"));
     }
-    if (nx * ny) as f64 > 5e6 {
-        return bad("dx", format!("makes {} particles: too many for this scene", nx * ny));
+    if nxf * nyf > 5e6 {
+        return Err(format!("scene `{scene}`: {plate} makes {:.3e} particles: more than 5e6", nxf * nyf));
+    }
+    let (nx, ny) = (nxf as usize, nyf as usize);
+    let hdx = p.float("hdx");
+    if !(0.5..=3.0).contains(&hdx) {
+        return bad(
+            "hdx",
+            "must lie in [0.5, 3]: the kernel must reach the nearest particles, and the clamp its support"
+                .into(),
+        );
     }
     let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
-    let h = p.float("hdx") * dx;
+    let h = hdx * dx;
     let layers = (kernel.support() * h / dx).ceil() as usize;
+    // Eq. (62) at the initial speed: a run of more steps than any machine takes is refused.
+    let dt = p.float("cfl") * h / (material.c0() * (1.0 + p.float("vf")));
+    let steps = p.float("tf") / dt;
+    if !(steps <= MAX_STEPS) {
+        return Err(format!(
+            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, h = `hdx` `dx`: more than {MAX_STEPS:e}",
+            p.float("tf"),
+            material.c0()
+        ));
+    }
     let pst = Pst::from_name(p.str("pst")).expect("checked choice");
     let name = SolidSchemeName::from_name(p.str("scheme")).expect("checked choice");
     let settings = SolidSettings {
@@ -159,9 +186,6 @@ fn setup(p: &Params) -> Result<Setup, String> {
         gravity: [0.0; 3],
     };
     let scheme = name.solid_scheme(&settings).map_err(|e| format!("scene `{scene}`: {e}"))?;
-    if p.float("vf") >= 1.0 {
-        return bad("vf", "must be below 1: the tip would start at the speed of sound".into());
-    }
     Ok(Setup { material, scheme, kernel, dx, h, nx, ny, layers })
 }
 
@@ -442,7 +466,10 @@ mod tests {
             let mut p = Params::defaults(&specs);
             p.set_str("oscillating_plate", &specs, key, value).unwrap();
             let e = setup(&p).err().unwrap();
-            assert!(e.contains(&format!("`{key}` = {value}")) || e.contains(&format!("`{key}` = {value}.0")), "{e}");
+            assert!(
+                e.contains(&format!("`{key}` = {value}")) || e.contains(&format!("`{key}` = {value}.0")),
+                "{e}"
+            );
         }
         for (key, value) in [("youngs_modulus", "0"), ("density", "-1"), ("dx", "0")] {
             let mut p = Params::defaults(&specs);

@@ -156,7 +156,14 @@ mod tests {
 
     fn solid(init: SolidInit<2>, dx: f64, pst: Pst, alpha: f64) -> ElasticSolid<2> {
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
-        let settings = SolidSettings { pst, corrections: true, alpha, u_ref: 1.0, w_dx: kernel.w(dx, dx), gravity: [0.0; 3] };
+        let settings = SolidSettings {
+            pst,
+            corrections: true,
+            alpha,
+            u_ref: 1.0,
+            w_dx: kernel.w(dx, dx),
+            gravity: [0.0; 3],
+        };
         let scheme = SolidSchemeName::Ctvf.solid_scheme(&settings).unwrap();
         ElasticSolid::new("block", dx, init, material(), scheme).unwrap()
     }
