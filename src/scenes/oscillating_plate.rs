@@ -168,7 +168,7 @@ fn setup(p: &Params) -> Result<Setup, String> {
     // Eq. (62) at the initial speed: a run of more steps than any machine takes is refused.
     let dt = p.float("cfl") * h / (material.c0() * (1.0 + p.float("vf")));
     let steps = p.float("tf") / dt;
-    if !(steps <= MAX_STEPS) {
+    if steps.is_nan() || steps > MAX_STEPS {
         return Err(format!(
             "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, h = `hdx` `dx`: more than {MAX_STEPS:e}",
             p.float("tf"),

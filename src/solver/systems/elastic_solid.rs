@@ -234,10 +234,12 @@ impl<const D: usize> ElasticSolid<D> {
     /// by rates evaluated at the start of the step with the half-step velocities (sec. 3.7).
     pub fn update_state(&mut self, r: &SolidRates<D>, dt: f64) {
         let material = self.material;
-        for i in 0..self.len() {
-            self.rho[i] += dt * r.drho[i];
-            self.p[i] = material.pressure(self.rho[i]);
-            self.s[i] += r.ds[i] * dt;
+        for ((rho, p), drho) in self.rho.iter_mut().zip(&mut self.p).zip(&r.drho) {
+            *rho += dt * drho;
+            *p = material.pressure(*rho);
+        }
+        for (s, ds) in self.s.iter_mut().zip(&r.ds) {
+            *s += ds * dt;
         }
     }
 
