@@ -11,7 +11,9 @@ use crate::solver::scheme::{
     Pst, SchemeName, SchemeOptions, SurfaceCone, SurfacePressure,
 };
 use crate::solver::simulation::{Simulation, TimeSettings};
-use crate::solver::systems::{Body, Fluid, FluidInit, Wall, WallDensity, WallPressure, WallViscosity};
+use crate::solver::systems::{
+    Body, ElasticSolid, Fluid, FluidInit, Wall, WallDensity, WallPressure, WallViscosity,
+};
 use std::path::Path;
 
 const SWITCH: &[&str] = &["auto", "on", "off"];
@@ -436,6 +438,9 @@ pub fn shifting_columns<const D: usize>(sim: &Simulation<D>) -> [(&'static str, 
 /// the shifting speed of the coming step, |u~ - u| (see [`Simulation::shift_speeds`]), as
 /// snapshot fields; nothing otherwise.
 pub fn shifting_fields<const D: usize>(sim: &Simulation<D>) -> Vec<Field<'static>> {
+    if !sim.has_fluid() {
+        return Vec::new();
+    }
     match (&sim.fluid().u_hat, sim.shift_speeds()) {
         (Some(u_hat), Some(shift)) => vec![
             Field::Vector("transport_velocity", u_hat.iter().map(pad).collect()),
@@ -469,6 +474,34 @@ pub fn write_wall<const D: usize>(path: &Path, w: &Wall<D>) -> std::io::Result<(
             Field::Vector("normal", w.normal.iter().map(pad).collect()),
         ],
     )
+}
+
+/// Writes an elastic solid's snapshot: velocity, speed, pressure, density, deviatoric
+/// stress (its components and von Mises' `sqrt(3 J2)`), the fixed flag, and its free
+/// surface if detected.
+pub fn write_solid<const D: usize>(
+    path: &Path,
+    s: &ElasticSolid<D>,
+    surface: Option<&crate::solver::passes::free_surface::SurfaceFields<D>>,
+) -> std::io::Result<()> {
+    use crate::solver::equations::solid::j2;
+    let mut fields = vec![
+        Field::Vector("velocity", s.u.iter().map(pad).collect()),
+        Field::Scalar("speed", s.u.iter().map(|u| u.norm()).collect()),
+        Field::Scalar("pressure", s.p.clone()),
+        Field::Scalar("density", s.rho.clone()),
+        Field::Scalar("von_mises", s.s.iter().map(|m| (3.0 * j2(m)).sqrt()).collect()),
+        Field::Int("fixed", s.fixed.iter().map(|&f| f as i64).collect()),
+    ];
+    for (name, (i, j)) in [("s00", (0, 0)), ("s01", (0, 1)), ("s11", (1, 1))] {
+        if i < D && j < D {
+            fields.push(Field::Scalar(name, s.s.iter().map(|m| m[(i, j)]).collect()));
+        }
+    }
+    if let Some(fs) = surface {
+        fields.push(Field::Int("free_surface", fs.surface.iter().map(|&f| f as i64).collect()));
+    }
+    write_vtu(path, &s.x.iter().map(pad).collect::<Vec<_>>(), &fields)
 }
 
 /// Shepard interpolation of `value` (per fluid particle) at `q`: `sum v W / sum W`, by
@@ -536,9 +569,24 @@ pub fn plan<const D: usize>(sim: &Simulation<D>, setting: &str) -> String {
                 }
             }
             Body::Wall(w) => bodies.push(format!("body `{}`: {} particles", w.name, w.len())),
+            Body::ElasticSolid(s) => bodies.push(format!(
+                "body `{}`: {} particles ({} fixed), h = {:.4e}, E = {:.4e} Pa, nu = {}, rho0 = {}, c0 = {:.4e} m/s",
+                s.name,
+                s.len(),
+                s.fixed.iter().filter(|&&f| f).count(),
+                s.h,
+                s.material.youngs_modulus,
+                s.material.poisson_ratio,
+                s.material.rho0,
+                s.material.c0()
+            )),
         }
     }
-    format!("{}, kernel {:?} ({setting})\n{}", bodies.join("; "), sim.kernel.kind(), sim.fluid().physics)
+    let mut schemes: Vec<String> = sim.solids().map(|s| format!("{}", s.physics)).collect();
+    if sim.has_fluid() {
+        schemes.insert(0, format!("{}", sim.fluid().physics));
+    }
+    format!("{}, kernel {:?} ({setting})\n{}", bodies.join("; "), sim.kernel.kind(), schemes.join("\n"))
 }
 
 /// The particles of each body of `sim` (each part of the fluid apart), by name.
@@ -548,6 +596,7 @@ pub fn body_particles<const D: usize>(sim: &Simulation<D>) -> Vec<(String, usize
         match body {
             Body::Fluid(f) => out.extend(f.parts.iter().map(|p| (p.name.clone(), p.ids.len()))),
             Body::Wall(w) => out.push((w.name.clone(), w.len())),
+            Body::ElasticSolid(s) => out.push((s.name.clone(), s.len())),
         }
     }
     out
@@ -583,6 +632,11 @@ pub fn snapshot_bodies<const D: usize>(
                 let name = format!("{}_{index:05}.vtu", w.name);
                 write_wall(&dir.join(&name), w)?;
                 files.push((w.name.clone(), name));
+            }
+            Body::ElasticSolid(s) => {
+                let name = format!("{}_{index:05}.vtu", s.name);
+                write_solid(&dir.join(&name), s, sim.solid_surface(&s.name))?;
+                files.push((s.name.clone(), name));
             }
         }
     }

@@ -10,6 +10,7 @@ pub mod free_surface_demo;
 pub mod geometry;
 pub mod harness;
 pub mod hydrostatic_tank;
+pub mod oscillating_plate;
 pub mod params;
 pub mod progress;
 pub mod tank;
@@ -94,6 +95,7 @@ pub const SCENES: &[SceneEntry] = &[
     dam_break::ENTRY,
     hydrostatic_tank::ENTRY,
     free_surface_demo::ENTRY,
+    oscillating_plate::ENTRY,
 ];
 
 /// Looks a scene up by name.
@@ -171,6 +173,8 @@ mod tests {
             ("dam_break", &["scheme=edac"]),
             ("hydrostatic_tank", &["height=0.01"]),
             ("free_surface_demo", &["dx=0.2"]),
+            ("oscillating_plate", &["poisson_ratio=0.5"]),
+            ("oscillating_plate", &["dx=0.05"]),
         ];
         for (scene, sets) in cases {
             let e = find(scene).unwrap();
@@ -193,6 +197,7 @@ mod tests {
             let coarse = match e.name {
                 "taylor_green" | "taylor_green_3d" | "cavity" => vec!["nx=16"],
                 "dam_break" => vec!["dx=0.1"],
+                "oscillating_plate" => vec!["dx=0.01"],
                 _ => vec![],
             };
             for pst in ["sun", "none"] {

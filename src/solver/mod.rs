@@ -34,6 +34,7 @@ macro_rules! named_choices {
 }
 
 pub mod equations;
+pub mod fracture;
 pub mod integrator;
 pub mod interactions;
 pub mod kernel;

@@ -15,24 +15,32 @@
 //! 5. IPST (eqs. 37-41);
 //! 6. the closing half kick of every body (eq. 60), and the blow-up check.
 //!
-//! The time step is the smallest of the bodies' limits (eq. 61).
+//! An elastic solid follows sec. 3.7 in the same stages: after the opening kick its density,
+//! pressure and deviatoric stress are updated by rates taken at the start positions with
+//! the half-step velocities (eqs. 25, 32, 56, 8, 58); after the drift it is listed again and
+//! its accelerations (eq. 30) and shifting (eq. 36) evaluated for the closing kick. A scene
+//! without a solid runs none of this; one without a fluid runs none of the fluid's stages.
+//!
+//! The time step is the smallest of the bodies' limits (eqs. 61, 62).
 
 use crate::solver::integrator::RatePositions;
 use crate::solver::interactions::boundary_fluid::BoundaryFluid;
 use crate::solver::interactions::fluid_boundary::{Boundaries, FluidBoundary};
 use crate::solver::interactions::fluid_fluid::FluidFluid;
+use crate::solver::interactions::solid_solid::SolidSolid;
 use crate::solver::interactions::{interaction, Interaction};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::passes::free_surface::SurfaceFields;
 use crate::solver::passes::ipst::{ipst_chi_reference, Ipst, Shifted};
-use crate::solver::passes::{accelerations, density, rates, FluidPasses, Particles};
+use crate::solver::passes::solid::SolidPasses;
+use crate::solver::passes::{accelerations, density, rates, solid, FluidPasses, Particles};
 use crate::solver::schedule::wavefront::applies as wavefront_applies;
 use crate::solver::schedule::{warm, StepBodies, Tuner, Wavefront};
 pub use crate::solver::schedule::{Schedule, TUNING_STEPS};
 use crate::solver::scheme::{DensityModel, PressureModel, Shifting, SurfacePressure};
-use crate::solver::systems::{Body, Fluid, FluidRates, Rates, Wall};
+use crate::solver::systems::{Body, ElasticSolid, Fluid, FluidRates, Rates, SolidRates, Wall};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -157,6 +165,8 @@ struct Couplings<const D: usize> {
     fluid_boundary: Vec<FluidBoundary<D>>,
     /// Each boundary extrapolating from the fluid.
     boundary_fluid: Vec<BoundaryFluid<D>>,
+    /// Each elastic solid among itself, with its passes' work space.
+    solids: Vec<(SolidSolid<D>, SolidPasses<D>)>,
 }
 
 /// What a fluid's passes keep from step to step: the gathered views, IPST's work space,
@@ -218,7 +228,9 @@ impl<const D: usize> Builder<D> {
                 }
             }
         }
-        let fluid = fluid.ok_or("a simulation needs a fluid body")?;
+        if fluid.is_none() && !bodies.iter().any(|b| matches!(b, Body::ElasticSolid(_))) {
+            return Err("a simulation needs a fluid or a solid body".into());
+        }
         let names: Vec<&str> = bodies.iter().flat_map(|b| b.names()).collect();
         for (k, name) in names.iter().enumerate() {
             if names[..k].contains(name) {
@@ -242,6 +254,7 @@ impl<const D: usize> Builder<D> {
         // One exhaustive decision per ordered pair of bodies.
         let mut fluid_boundary = Vec::new();
         let mut boundary_fluid = Vec::new();
+        let mut solids = Vec::new();
         for (i, dst) in bodies.iter().enumerate() {
             for (j, src) in bodies.iter().enumerate() {
                 if off.contains(&(i, j)) {
@@ -252,14 +265,27 @@ impl<const D: usize> Builder<D> {
                     Some(Interaction::FluidFluid) => debug_assert_eq!(i, j, "one fluid"),
                     Some(Interaction::FluidBoundary) => fluid_boundary.push(FluidBoundary::new(i, j)),
                     Some(Interaction::BoundaryFluid) => boundary_fluid.push(BoundaryFluid::new(i, j)),
-                    None => {}
+                    // A solid with itself; two solid bodies do not meet yet (no contact).
+                    Some(Interaction::SolidSolid) if i == j => {
+                        solids.push((SolidSolid::new(i), SolidPasses::default()))
+                    }
+                    Some(Interaction::SolidSolid) | None => {}
                 }
             }
         }
-        let f = bodies[fluid].as_fluid_mut().expect("the fluid's index");
-        f.physics.resolve_reference(!fluid_boundary.is_empty());
-        let radius = kernel.support() * f.h;
-        let surface = f.physics.free_surface.map(|_| SurfaceFields::default());
+        // The search radius of the fluid's kernel, or of the widest solid's without a fluid
+        // (or with a wider solid).
+        let mut radius: f64 = 0.0;
+        let mut surface = None;
+        if let Some(fluid) = fluid {
+            let f = bodies[fluid].as_fluid_mut().expect("the fluid's index");
+            f.physics.resolve_reference(!fluid_boundary.is_empty());
+            radius = kernel.support() * f.h;
+            surface = f.physics.free_surface.map(|_| SurfaceFields::default());
+        }
+        for s in bodies.iter().filter_map(Body::as_solid) {
+            radius = radius.max(kernel.support() * s.h);
+        }
         domain.check_periodic(radius)?;
         // Each body's cell list spans the box: one far larger than its particles need (a
         // box holding a long prescribed travel, say) would take the memory, or overflow.
@@ -275,6 +301,7 @@ impl<const D: usize> Builder<D> {
             .iter()
             .map(|b| match b {
                 Body::Fluid(f) => Rates::Fluid(FluidRates::of(f)),
+                Body::ElasticSolid(s) => Rates::Solid(SolidRates::of(s)),
                 Body::Wall(_) => Rates::None,
             })
             .collect();
@@ -297,7 +324,7 @@ impl<const D: usize> Builder<D> {
             state,
             fluid,
             bins,
-            couplings: Couplings { fluid_fluid: FluidFluid::new(), fluid_boundary, boundary_fluid },
+            couplings: Couplings { fluid_fluid: FluidFluid::new(), fluid_boundary, boundary_fluid, solids },
             work: FluidWork { surface, ..Default::default() },
             wave: Wavefront::new(),
             schedule: Schedule::default(),
@@ -311,8 +338,8 @@ impl<const D: usize> Builder<D> {
     }
 }
 
-/// One simulation: a domain, named bodies (one fluid, any number of walls) and who acts on
-/// whom, stepped by kick-drift-kick.
+/// One simulation: a domain, named bodies (at most one fluid, any number of walls and
+/// elastic solids) and who acts on whom, stepped by kick-drift-kick.
 pub struct Simulation<const D: usize> {
     /// The box.
     pub domain: Domain<D>,
@@ -322,8 +349,8 @@ pub struct Simulation<const D: usize> {
     pub time_settings: TimeSettings,
     /// Everything that evolves.
     pub state: State<D>,
-    /// The index of the fluid among the bodies.
-    fluid: usize,
+    /// The index of the fluid among the bodies, if there is one.
+    fluid: Option<usize>,
     /// Each body's binning, in the order of the bodies (a body that does not move is binned
     /// once).
     bins: Vec<CellList<D>>,
@@ -385,6 +412,15 @@ impl<const D: usize> Simulation<D> {
     fn start(&mut self) {
         self.rebin();
         self.relist();
+        if self.fluid.is_some() {
+            self.start_fluid();
+        }
+        let dt = self.nominal_dt();
+        self.solid_accelerations(dt);
+    }
+
+    /// The fluid's part of [`start`](Self::start).
+    fn start_fluid(&mut self) {
         let free_surface = self.fluid().physics.free_surface.is_some();
         let fluid = self.fluid();
         let reference = ipst_chi_reference(
@@ -394,7 +430,7 @@ impl<const D: usize> Simulation<D> {
             &self.kernel,
             free_surface,
         );
-        let f = self.fluid;
+        let f = self.f();
         let fluid = self.state.bodies[f].as_fluid_mut().expect("the fluid's index");
         if let Some(t) = fluid.physics.transport.as_mut() {
             if let Shifting::Ipst { chi_ref, .. } = &mut t.shifting {
@@ -421,24 +457,59 @@ impl<const D: usize> Simulation<D> {
     pub fn restore(&mut self, state: State<D>) {
         self.state = state;
         for (k, body) in self.state.bodies.iter_mut().enumerate() {
-            if let Body::Wall(w) = body {
-                w.boundary.resize();
-                self.bins[k].update(&w.x);
+            match body {
+                Body::Wall(w) => {
+                    w.boundary.resize();
+                    self.bins[k].update(&w.x);
+                }
+                Body::ElasticSolid(s) => self.bins[k].update(&s.x),
+                Body::Fluid(_) => {}
             }
         }
-        let f = self.fluid;
-        self.bins[f].update(self.state.bodies[f].x());
+        if let Some(f) = self.fluid {
+            self.bins[f].update(self.state.bodies[f].x());
+        }
         self.relist();
     }
 
-    /// The fluid (all its parts).
-    pub fn fluid(&self) -> &Fluid<D> {
-        self.state.bodies[self.fluid].as_fluid().expect("the fluid's index")
+    /// The fluid's index; panics for a simulation without one (the fluid's stages run only
+    /// when there is one).
+    fn f(&self) -> usize {
+        self.fluid.expect("a simulation with a fluid")
     }
 
-    /// The fluid's rates.
+    /// The fluid (all its parts). Panics for a simulation without a fluid.
+    pub fn fluid(&self) -> &Fluid<D> {
+        self.state.bodies[self.f()].as_fluid().expect("the fluid's index")
+    }
+
+    /// The fluid's rates. Panics for a simulation without a fluid.
     pub fn fluid_rates(&self) -> &FluidRates<D> {
-        self.state.rates[self.fluid].as_fluid().expect("the fluid's rates")
+        self.state.rates[self.f()].as_fluid().expect("the fluid's rates")
+    }
+
+    /// Whether the simulation has a fluid body.
+    pub fn has_fluid(&self) -> bool {
+        self.fluid.is_some()
+    }
+
+    /// The elastic solids, in the order of the bodies.
+    pub fn solids(&self) -> impl Iterator<Item = &ElasticSolid<D>> {
+        self.state.bodies.iter().filter_map(Body::as_solid)
+    }
+
+    /// The solid body named `name`, with its rates.
+    pub fn solid(&self, name: &str) -> Option<(&ElasticSolid<D>, &SolidRates<D>)> {
+        let k = self.state.bodies.iter().position(|b| b.as_solid().is_some_and(|s| s.name == name))?;
+        Some((self.state.bodies[k].as_solid()?, self.state.rates[k].as_solid()?))
+    }
+
+    /// The free surface of the solid named `name`, if its scheme detects one (after the
+    /// first evaluation).
+    pub fn solid_surface(&self, name: &str) -> Option<&SurfaceFields<D>> {
+        let bodies = &self.state.bodies;
+        let (_, passes) = self.couplings.solids.iter().find(|(c, _)| bodies[c.body].names() == [name])?;
+        passes.surface.as_ref()
     }
 
     /// The bodies, in order.
@@ -490,6 +561,11 @@ impl<const D: usize> Simulation<D> {
                 }
                 Body::Wall(wall) if wall.moves() => cells.update(&wall.x),
                 Body::Wall(_) => {}
+                // A solid keeps its particles in the order given (no reordering).
+                Body::ElasticSolid(solid) => {
+                    solid.x.iter_mut().for_each(|x| domain.wrap(x));
+                    cells.update(&solid.x)
+                }
             }
         }
     }
@@ -518,12 +594,13 @@ impl<const D: usize> Simulation<D> {
     /// [applies](wavefront_applies) to) and the body, as binned now, makes enough tiles for
     /// it; else as sweeps. Also whether the tuner times the step.
     fn order(&mut self) -> (Schedule, bool) {
+        let Some(f) = self.fluid else { return (Schedule::Sweeps, false) };
         let fluid = self.fluid();
         let allowed = self.schedule != Schedule::Sweeps
             && self.time_settings.rate_positions == RatePositions::End
             && wavefront_applies(&fluid.physics, self.state.bodies.len() == 1);
         let n = fluid.len();
-        let (wave, cells) = (&mut self.wave, &self.bins[self.fluid]);
+        let (wave, cells) = (&mut self.wave, &self.bins[f]);
         match self.schedule {
             _ if !allowed => (Schedule::Sweeps, false),
             Schedule::Wavefront if wave.plan(cells, n) => (self.schedule, false),
@@ -548,7 +625,7 @@ impl<const D: usize> Simulation<D> {
     /// The listing, summation density, pass A over `dt` and pass B of a step as a
     /// wavefront over the tiles just planned.
     fn wavefront_passes(&mut self, dt: f64, dt_nominal: f64) {
-        let f = self.fluid;
+        let f = self.f();
         let st = &mut self.state;
         let bodies = StepBodies {
             fluid: st.bodies[f].as_fluid_mut().expect("the fluid's index"),
@@ -588,7 +665,10 @@ impl<const D: usize> Simulation<D> {
     /// boundaries' extrapolation.
     fn relist(&mut self) {
         let (bodies, bins, kernel) = (&self.state.bodies, &self.bins, &self.kernel);
-        let f = self.fluid;
+        for (c, _) in &mut self.couplings.solids {
+            c.relist(&bins[c.body], bodies[c.body].as_solid().expect("a solid"), kernel);
+        }
+        let Some(f) = self.fluid else { return };
         let fluid = bodies[f].as_fluid().expect("the fluid's index");
         self.couplings.fluid_fluid.relist(&bins[f], fluid, kernel);
         for c in &mut self.couplings.fluid_boundary {
@@ -609,7 +689,7 @@ impl<const D: usize> Simulation<D> {
             let g = fluid.physics.gravity_vector();
             match boundary {
                 Body::Wall(wall) => c.extrapolate(wall, fluid, g),
-                Body::Fluid(_) => unreachable!("a fluid is no boundary"),
+                Body::Fluid(_) | Body::ElasticSolid(_) => unreachable!("only a wall is a boundary"),
             }
         }
     }
@@ -617,7 +697,7 @@ impl<const D: usize> Simulation<D> {
     /// The fluid's summation density: its own share, summed as its list was built, and
     /// each boundary's.
     fn summation_density(&mut self) {
-        let f = self.fluid;
+        let f = self.f();
         // Out of the body while the boundaries, among the bodies, are read (a move, no copy).
         let mut rho = std::mem::take(&mut self.state.bodies[f].as_fluid_mut().expect("the fluid").rho);
         let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &self.state.bodies);
@@ -632,6 +712,7 @@ impl<const D: usize> Simulation<D> {
     /// velocity. (The stored u~ is of the last half step and u of the full step, so their
     /// difference also holds dt/2 du/dt.)
     pub fn shift_speeds(&self) -> Option<Vec<f64>> {
+        self.fluid?;
         self.fluid().u_hat.as_ref()?;
         let rates = self.fluid_rates();
         let half_dt = 0.5 * rates.a_c_dt.unwrap_or_else(|| self.nominal_dt());
@@ -648,7 +729,7 @@ impl<const D: usize> Simulation<D> {
     /// The free surface, if declared, and pass B.
     fn accelerations(&mut self, dt_nominal: f64) {
         let clock = std::time::Instant::now();
-        let f = self.fluid;
+        let f = self.f();
         let free = self.fluid().physics.free_surface;
         if let (Some(fs), Some(free)) = (self.work.surface.as_mut(), free) {
             let fluid = self.state.bodies[f].as_fluid().expect("the fluid");
@@ -682,7 +763,7 @@ impl<const D: usize> Simulation<D> {
     /// IPST's pass (eqs. 37-41), if the fluid shifts with it, after pass B.
     fn homogenise(&mut self, dt_nominal: f64, next_step: u64) {
         let clock = std::time::Instant::now();
-        let f = self.fluid;
+        let f = self.f();
         let st = &mut self.state;
         let fluid = st.bodies[f].as_fluid().expect("the fluid");
         let rates = st.rates[f].as_fluid_mut().expect("the fluid's rates");
@@ -711,7 +792,7 @@ impl<const D: usize> Simulation<D> {
     /// Pass A: the density and pressure rates (eqs. 25-26) on the current neighbour lists
     /// and boundaries, and their updates over `dt` (eqs. 56-57).
     fn density_and_pressure(&mut self, dt: f64) {
-        let f = self.fluid;
+        let f = self.f();
         let st = &mut self.state;
         let fluid = st.bodies[f].as_fluid().expect("the fluid");
         let boundaries = Boundaries::new(&self.couplings.fluid_boundary, &st.bodies);
@@ -739,11 +820,13 @@ impl<const D: usize> Simulation<D> {
             body.kick_open(rates, dt);
         }
         let mut clock = lap(clock, &mut self.times.integrate);
-        if rates_at == RatePositions::Start {
+        if rates_at == RatePositions::Start && self.fluid.is_some() {
             // The neighbour lists and the boundaries are still those of the start positions.
             self.density_and_pressure(dt);
             clock = lap(clock, &mut self.times.pressure);
         }
+        // Sec. 3.7: a solid's rates at the start positions, its lists still theirs.
+        self.solid_rates_and_update(dt);
         for body in &mut self.state.bodies {
             body.drift(dt);
         }
@@ -754,12 +837,17 @@ impl<const D: usize> Simulation<D> {
         // homogenisation acceleration): tile by tile or pass by pass, as the schedule says.
         let (schedule, timed) = self.order();
         self.last_schedule = schedule;
-        if schedule == Schedule::Wavefront {
+        if self.fluid.is_none() {
+            self.relist();
+        } else if schedule == Schedule::Wavefront {
             self.wavefront_passes(dt, dt_nominal);
         } else {
             self.swept_passes(dt, dt_nominal);
         }
-        self.homogenise(dt_nominal, self.state.steps + 1);
+        if self.fluid.is_some() {
+            self.homogenise(dt_nominal, self.state.steps + 1);
+        }
+        self.solid_accelerations(dt_nominal);
         let clock = std::time::Instant::now();
         for (body, rates) in self.state.bodies.iter_mut().zip(&self.state.rates) {
             body.kick_close(rates, dt);
@@ -799,8 +887,11 @@ impl<const D: usize> Simulation<D> {
         })
     }
 
-    /// Largest fluid particle speed.
+    /// Largest fluid particle speed (0 without a fluid).
     pub fn max_speed(&self) -> f64 {
+        if self.fluid.is_none() {
+            return 0.0;
+        }
         self.fluid()
             .u
             .par_iter()
@@ -813,6 +904,10 @@ impl<const D: usize> Simulation<D> {
     /// Blow-up detection: non-finite fields, speeds beyond the bound, particles outside a
     /// bounded domain. Also records the largest speed for the next time step.
     fn check(&mut self) -> Result<(), Divergence> {
+        self.check_solids()?;
+        if self.fluid.is_none() {
+            return Ok(());
+        }
         let f = self.fluid();
         let domain = &self.domain;
         // (max |u|^2, first bad particle index) over particles; max and min are exact
@@ -869,6 +964,59 @@ impl<const D: usize> Simulation<D> {
         Ok(())
     }
 
+    /// The density, pressure and deviatoric-stress rates of every solid at the current
+    /// positions and velocities (eqs. 25, 31, 32), and their update over `dt` (eqs. 56, 8,
+    /// 58).
+    fn solid_rates_and_update(&mut self, dt: f64) {
+        let st = &mut self.state;
+        for (c, passes) in &mut self.couplings.solids {
+            let solid = st.bodies[c.body].as_solid().expect("a solid");
+            let rates = st.rates[c.body].as_solid_mut().expect("a solid's rates");
+            solid::density_and_stress_rates(passes, solid, &c.list, rates);
+            let Body::ElasticSolid(solid) = &mut st.bodies[c.body] else { unreachable!("a solid") };
+            solid.update_state(st.rates[c.body].as_solid().expect("a solid's rates"), dt);
+        }
+    }
+
+    /// The accelerations (eq. 30) and shifting (eq. 36, for a step `dt`) of every solid.
+    fn solid_accelerations(&mut self, dt: f64) {
+        let st = &mut self.state;
+        for (c, passes) in &mut self.couplings.solids {
+            let solid = st.bodies[c.body].as_solid().expect("a solid");
+            let rates = st.rates[c.body].as_solid_mut().expect("a solid's rates");
+            solid::accelerations(passes, solid, &c.list, rates, dt);
+        }
+    }
+
+    /// Blow-up detection of the solids: non-finite fields, a particle outside a bounded
+    /// domain, a speed beyond `blowup_factor` times the solid's speed of sound.
+    fn check_solids(&self) -> Result<(), Divergence> {
+        let fail = |reason: String| Divergence { reason, step: self.state.steps, time: self.state.time };
+        for s in self.solids() {
+            let finite = |i: usize| {
+                s.x[i].iter().chain(s.u[i].iter()).chain(s.s[i].iter()).all(|v| v.is_finite())
+                    && s.p[i].is_finite()
+                    && s.rho[i].is_finite()
+            };
+            if let Some(i) = (0..s.len()).find(|&i| !finite(i)) {
+                return Err(fail(format!("a field is not finite (particle {i} of solid `{}`)", s.name)));
+            }
+            if let Some(i) = (0..s.len()).find(|&i| !self.domain.contains(&s.x[i])) {
+                return Err(fail(format!("particle {i} of solid `{}` left the domain", s.name)));
+            }
+            let bound = self.time_settings.blowup_factor * s.material.c0();
+            if s.max_speed() > bound {
+                return Err(fail(format!(
+                    "max |u| = {:.4e} of solid `{}` exceeds {} c0 = {bound:.4e}",
+                    s.max_speed(),
+                    s.name,
+                    self.time_settings.blowup_factor
+                )));
+            }
+        }
+        Ok(())
+    }
+
     /// The fluid's positions, wrapped into the box, for output.
     pub fn positions(&self) -> &[Vector<D>] {
         &self.fluid().x
@@ -891,6 +1039,12 @@ fn tuner_for(tuners: &mut Vec<(usize, Tuner)>) -> &mut Tuner {
 impl<const D: usize> From<Fluid<D>> for Body<D> {
     fn from(f: Fluid<D>) -> Self {
         Body::Fluid(f)
+    }
+}
+
+impl<const D: usize> From<ElasticSolid<D>> for Body<D> {
+    fn from(s: ElasticSolid<D>) -> Self {
+        Body::ElasticSolid(s)
     }
 }
 
@@ -1040,7 +1194,7 @@ mod tests {
         assert!(itself.contains("are one body"), "{itself}");
         assert_eq!(
             Simulation::<2>::builder(sim.domain, sim.kernel).build().err().unwrap(),
-            "a simulation needs a fluid body"
+            "a simulation needs a fluid or a solid body"
         );
     }
 

@@ -8,13 +8,27 @@ use crate::solver::math::Vector;
 /// (eq. 29); `c` is the (uniform) speed of sound.
 #[inline(always)]
 pub fn monaghan<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair<D>, alpha: f64, c: f64) -> Vector<D> {
-    let vr = (a.u - b.u).dot(&ab.xij);
+    monaghan_values(a.u - b.u, (a.rho, b.rho), b.m, ab, alpha, c)
+}
+
+/// [`monaghan`] from the values it reads: the velocity difference `u_ab`, the densities
+/// `(rho_a, rho_b)` and the neighbour's mass `m_b` (for any body kind's particles).
+#[inline(always)]
+pub fn monaghan_values<const D: usize>(
+    u_ab: Vector<D>,
+    (rho_a, rho_b): (f64, f64),
+    m_b: f64,
+    ab: &Pair<D>,
+    alpha: f64,
+    c: f64,
+) -> Vector<D> {
+    let vr = u_ab.dot(&ab.xij);
     if vr >= 0.0 {
         return Vector::zeros();
     }
     let phi = vr * ab.inv_r2_eps;
-    let pi_ab = -alpha * ab.h * c * phi / (0.5 * (a.rho + b.rho));
-    ab.dwij * (-b.m * pi_ab)
+    let pi_ab = -alpha * ab.h * c * phi / (0.5 * (rho_a + rho_b));
+    ab.dwij * (-m_b * pi_ab)
 }
 
 #[cfg(test)]

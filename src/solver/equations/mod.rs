@@ -12,6 +12,7 @@ pub mod edac;
 pub mod free_surface;
 pub mod momentum;
 pub mod shifting;
+pub mod solid;
 pub mod viscosity;
 pub mod wall;
 

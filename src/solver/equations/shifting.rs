@@ -17,7 +17,13 @@ pub fn background_pressure<const D: usize>(a: &Point<D>, b: &Point<D>, ab: &Pair
 /// `-(Ma 2h c_0 / dt)` times the sum over neighbours.
 #[inline(always)]
 pub fn sun2019<const D: usize>(b: &Point<D>, ab: &Pair<D>, w_dx: f64, r: f64, n: i32) -> Vector<D> {
-    ab.dwij * (b.v() * (1.0 + r * powi_small(ab.wij / w_dx, n)))
+    sun2019_volume(b.v(), ab, w_dx, r, n)
+}
+
+/// [`sun2019`] from the neighbour's volume `v_b` (for any body kind's particles).
+#[inline(always)]
+pub fn sun2019_volume<const D: usize>(v_b: f64, ab: &Pair<D>, w_dx: f64, r: f64, n: i32) -> Vector<D> {
+    ab.dwij * (v_b * (1.0 + r * powi_small(ab.wij / w_dx, n)))
 }
 
 /// `x^n` for a small non-negative `n` by repeated multiplication (`powi` with a

@@ -8,6 +8,7 @@
 //! - [`fluid_fluid`]: a fluid's particles among themselves, CTVF eqs. (25)-(27);
 //! - [`fluid_boundary`]: a fluid reading a boundary's extrapolated values as neighbours;
 //! - [`boundary_fluid`]: a boundary extrapolating its values from a fluid (eqs. 46-52);
+//! - [`solid_solid`]: an elastic solid's particles among themselves, eqs. (25), (30)-(32);
 //! - [`lists`]: the neighbour lists with their kernel values, shared by all of them.
 //!
 //! Reactions stay deterministic without atomics: every pass is a gather, each particle
@@ -17,6 +18,7 @@ pub mod boundary_fluid;
 pub mod fluid_boundary;
 pub mod fluid_fluid;
 pub mod lists;
+pub mod solid_solid;
 
 use crate::solver::systems::BodyKind;
 
@@ -32,18 +34,30 @@ pub enum Interaction {
     /// A boundary extrapolates its pressure and velocities from a fluid (eqs. 46-52,
     /// [`boundary_fluid`]).
     BoundaryFluid,
+    /// An elastic solid's particles among themselves: density, stress and momentum
+    /// (eqs. 25, 30-32), shifting and free-surface detection ([`solid_solid`]).
+    SolidSolid,
 }
 
 /// How body kind `dst` is acted on by body kind `src` (`None`: not at all). For two bodies
 /// of one kind this is also the interaction of a body with itself.
 pub fn interaction(dst: BodyKind, src: BodyKind) -> Option<Interaction> {
-    use BodyKind::{Fluid, Wall};
+    use BodyKind::{ElasticSolid, Fluid, Wall};
     match (dst, src) {
         (Fluid, Fluid) => Some(Interaction::FluidFluid),
         (Fluid, Wall) => Some(Interaction::FluidBoundary),
         (Wall, Fluid) => Some(Interaction::BoundaryFluid),
         // Walls neither move by forces nor present values to each other.
         (Wall, Wall) => None,
+        // Within one solid (the simulation pairs a solid only with itself: contact between
+        // two solid bodies is not modelled yet, so two solids pass through each other).
+        (ElasticSolid, ElasticSolid) => Some(Interaction::SolidSolid),
+        // Fluid-structure coupling is a later stage: a fluid and a solid do not see each
+        // other yet.
+        (Fluid, ElasticSolid) | (ElasticSolid, Fluid) => None,
+        // Solid-wall contact is a later stage too (a clamp is made of the solid's own fixed
+        // particles, see `systems::elastic_solid`).
+        (ElasticSolid, Wall) | (Wall, ElasticSolid) => None,
     }
 }
 
@@ -58,5 +72,10 @@ mod tests {
         assert_eq!(interaction(Fluid, Wall), Some(Interaction::FluidBoundary));
         assert_eq!(interaction(Wall, Fluid), Some(Interaction::BoundaryFluid));
         assert_eq!(interaction(Wall, Wall), None);
+        use BodyKind::ElasticSolid;
+        assert_eq!(interaction(ElasticSolid, ElasticSolid), Some(Interaction::SolidSolid));
+        for other in [Fluid, Wall] {
+            assert_eq!((interaction(ElasticSolid, other), interaction(other, ElasticSolid)), (None, None));
+        }
     }
 }

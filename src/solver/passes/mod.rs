@@ -9,7 +9,8 @@
 //! - [`rates`]: pass A, the density and pressure rates (eqs. 25-26) and their update;
 //! - [`accelerations`]: pass B, the accelerations (eq. 27) and the homogenisation;
 //! - [`free_surface`]: the detection of a free surface (sec. 3.4);
-//! - [`ipst`]: the iterative shifting (eqs. 37-41), whose sweeps evaluate each pair once.
+//! - [`ipst`]: the iterative shifting (eqs. 37-41), whose sweeps evaluate each pair once;
+//! - [`solid`]: an elastic solid's rates (eqs. 25, 31, 32) and accelerations (eq. 30).
 //!
 //! Detection, the summation density and IPST read a body as [`Particles`] and its
 //! boundaries as [`Boundaries`], so that any body kind can use them.
@@ -19,6 +20,7 @@ pub mod density;
 pub mod free_surface;
 pub mod ipst;
 pub mod rates;
+pub mod solid;
 
 use crate::solver::equations::{Pair, Point};
 use crate::solver::interactions::fluid_boundary::Boundaries;

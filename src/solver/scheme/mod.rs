@@ -10,8 +10,10 @@
 
 pub mod plan;
 pub mod settings;
+pub mod solid;
 
 pub use settings::{FluidSettings, OptionError, SchemeOptions};
+pub use solid::{GradientVelocity, SolidScheme, SolidSchemeName, SolidSettings, SolidShifting};
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

@@ -7,16 +7,19 @@
 //!
 //! - [`fluid`]: a weakly compressible fluid (CTVF sec. 2-3), integrated;
 //! - [`wall`]: wall particles with a prescribed motion, not integrated, presenting
-//!   extrapolated values to the fluid through the [`boundary`] model they embed.
+//!   extrapolated values to the fluid through the [`boundary`] model they embed;
+//! - [`elastic_solid`]: an elastic solid (CTVF sec. 2-3, eqs. 8, 25, 30-32), integrated.
 //!
 //! Who acts on whom is decided in [`interactions`](crate::solver::interactions), by one
 //! exhaustive `match` over the [`BodyKind`]s.
 
 pub mod boundary;
+pub mod elastic_solid;
 pub mod fluid;
 pub mod wall;
 
 pub use boundary::{BoundaryMaterial, BoundaryModel, Presented, WallDensity, WallPressure, WallViscosity};
+pub use elastic_solid::{ElasticSolid, SolidInit, SolidMaterial, SolidRates};
 pub use fluid::{Fluid, FluidInit, FluidPart, FluidRates};
 pub use wall::{Wall, WallMotion};
 
@@ -33,6 +36,8 @@ pub enum Body<const D: usize> {
     Fluid(Fluid<D>),
     /// Wall particles.
     Wall(Wall<D>),
+    /// An elastic solid.
+    ElasticSolid(ElasticSolid<D>),
 }
 
 /// The kinds of body, as the interaction match sees them.
@@ -42,6 +47,8 @@ pub enum BodyKind {
     Fluid,
     /// [`Wall`].
     Wall,
+    /// [`ElasticSolid`].
+    ElasticSolid,
 }
 
 impl<const D: usize> Body<D> {
@@ -50,6 +57,7 @@ impl<const D: usize> Body<D> {
         match self {
             Body::Fluid(_) => BodyKind::Fluid,
             Body::Wall(_) => BodyKind::Wall,
+            Body::ElasticSolid(_) => BodyKind::ElasticSolid,
         }
     }
 
@@ -58,6 +66,7 @@ impl<const D: usize> Body<D> {
         match self {
             Body::Fluid(f) => f.parts.iter().map(|p| p.name.as_str()).collect(),
             Body::Wall(w) => vec![w.name.as_str()],
+            Body::ElasticSolid(s) => vec![s.name.as_str()],
         }
     }
 
@@ -66,6 +75,7 @@ impl<const D: usize> Body<D> {
         match self {
             Body::Fluid(f) => f.len(),
             Body::Wall(w) => w.len(),
+            Body::ElasticSolid(s) => s.len(),
         }
     }
 
@@ -79,6 +89,7 @@ impl<const D: usize> Body<D> {
         match self {
             Body::Fluid(f) => &f.x,
             Body::Wall(w) => &w.x,
+            Body::ElasticSolid(s) => &s.x,
         }
     }
 
@@ -98,6 +109,14 @@ impl<const D: usize> Body<D> {
         }
     }
 
+    /// The elastic solid, if this is one.
+    pub fn as_solid(&self) -> Option<&ElasticSolid<D>> {
+        match self {
+            Body::ElasticSolid(s) => Some(s),
+            _ => None,
+        }
+    }
+
     /// The wall, if this is one.
     pub fn as_wall(&self) -> Option<&Wall<D>> {
         match self {
@@ -111,23 +130,25 @@ impl<const D: usize> Body<D> {
     pub fn as_boundary(&self) -> Option<(&[Vector<D>], &BoundaryModel<D>)> {
         match self {
             Body::Wall(w) => Some((&w.x, &w.boundary)),
-            Body::Fluid(_) => None,
+            Body::Fluid(_) | Body::ElasticSolid(_) => None,
         }
     }
 
     /// Whether the body's particles move (and so must be binned again after the drift).
     pub fn moves(&self) -> bool {
         match self {
-            Body::Fluid(_) => true,
+            Body::Fluid(_) | Body::ElasticSolid(_) => true,
             Body::Wall(w) => w.moves(),
         }
     }
 
-    /// The largest time step the body allows at `cfl` (eq. 61), given its largest particle
-    /// speed `u_max`; `None` for a body that sets no limit (a wall's motion is prescribed).
+    /// The largest time step the body allows at `cfl` (eq. 61), given the fluid's largest
+    /// particle speed `u_max` (a solid takes its own, eq. 62); `None` for a body that sets
+    /// no limit (a wall's motion is prescribed).
     pub fn dt_limit(&self, cfl: f64, u_max: f64) -> Option<f64> {
         match self {
             Body::Fluid(f) => Some(f.dt_limit(cfl, u_max)),
+            Body::ElasticSolid(s) => Some(s.dt_limit(cfl)),
             Body::Wall(_) => None,
         }
     }
@@ -136,8 +157,10 @@ impl<const D: usize> Body<D> {
     pub fn kick_open(&mut self, rates: &Rates<D>, dt: f64) {
         match (self, rates) {
             (Body::Fluid(f), Rates::Fluid(r)) => f.kick_open(r, dt),
+            (Body::ElasticSolid(s), Rates::Solid(r)) => s.kick_open(r, dt),
             (Body::Wall(w), _) => w.half_kick(dt),
             (Body::Fluid(_), _) => unreachable!("a fluid's rates are fluid rates"),
+            (Body::ElasticSolid(_), _) => unreachable!("a solid's rates are solid rates"),
         }
     }
 
@@ -146,6 +169,7 @@ impl<const D: usize> Body<D> {
         match self {
             Body::Fluid(f) => f.drift(dt),
             Body::Wall(w) => w.drift(dt),
+            Body::ElasticSolid(s) => s.drift(dt),
         }
     }
 
@@ -153,8 +177,10 @@ impl<const D: usize> Body<D> {
     pub fn kick_close(&mut self, rates: &Rates<D>, dt: f64) {
         match (self, rates) {
             (Body::Fluid(f), Rates::Fluid(r)) => f.kick_close(r, dt),
+            (Body::ElasticSolid(s), Rates::Solid(r)) => s.kick_close(r, dt),
             (Body::Wall(w), _) => w.half_kick(dt),
             (Body::Fluid(_), _) => unreachable!("a fluid's rates are fluid rates"),
+            (Body::ElasticSolid(_), _) => unreachable!("a solid's rates are solid rates"),
         }
     }
 }
@@ -164,16 +190,34 @@ impl<const D: usize> Body<D> {
 pub enum Rates<const D: usize> {
     /// A fluid's.
     Fluid(FluidRates<D>),
+    /// An elastic solid's.
+    Solid(SolidRates<D>),
     /// None: the body is not integrated (its motion, if any, is prescribed).
     None,
 }
 
 impl<const D: usize> Rates<D> {
+    /// A solid's rates, if these are.
+    pub fn as_solid(&self) -> Option<&SolidRates<D>> {
+        match self {
+            Rates::Solid(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// A solid's rates, if these are, mutably.
+    pub fn as_solid_mut(&mut self) -> Option<&mut SolidRates<D>> {
+        match self {
+            Rates::Solid(r) => Some(r),
+            _ => None,
+        }
+    }
+
     /// A fluid's rates, if these are.
     pub fn as_fluid(&self) -> Option<&FluidRates<D>> {
         match self {
             Rates::Fluid(r) => Some(r),
-            Rates::None => None,
+            Rates::Solid(_) | Rates::None => None,
         }
     }
 
@@ -181,7 +225,7 @@ impl<const D: usize> Rates<D> {
     pub fn as_fluid_mut(&mut self) -> Option<&mut FluidRates<D>> {
         match self {
             Rates::Fluid(r) => Some(r),
-            Rates::None => None,
+            Rates::Solid(_) | Rates::None => None,
         }
     }
 }

@@ -1,0 +1,238 @@
+//! Elastic solids (CTVF sec. 2-3): the continuity equation with its transport-velocity
+//! correction (eq. 25), the velocity gradient (eq. 31), the Jaumann stress rate with its
+//! transport terms (eqs. 4, 21, 32) and the solid momentum equation (eq. 30), one function
+//! per term.
+//!
+//! Conventions as in [`super`]: `a` the particle being updated, `b` a neighbour,
+//! `x_ab = x_a - x_b`, `grad W = grad_a W_ab`, `V_b = m_b / rho_b`, `du = u~ - u`, and the
+//! SPH divergence `(div f)_a = -sum_b V_b f_ab . grad W`. The deviatoric stress sigma' is a
+//! symmetric D x D [`Matrix`]; in 2D the model is plane strain, as in the paper (its
+//! deviator subtracts a third of the trace, eq. 4, and sigma'_zz is not tracked).
+
+use super::Pair;
+use crate::solver::math::{Matrix, Vector};
+
+/// The values of one solid particle a term may read, gathered once per pass.
+#[derive(Clone, Copy, Debug)]
+pub struct SolidPoint<const D: usize> {
+    /// Momentum velocity u.
+    pub u: Vector<D>,
+    /// The velocity the velocity gradient is taken of: u (CTVF, eq. 31) or u~ (GTVF).
+    pub v_grad: Vector<D>,
+    /// The shifting part of the transport velocity, `u~ - u` (zero without shifting).
+    pub du: Vector<D>,
+    /// Mass.
+    pub m: f64,
+    /// Density.
+    pub rho: f64,
+    /// Pressure.
+    pub p: f64,
+    /// Deviatoric stress sigma'.
+    pub s: Matrix<D>,
+    /// Volume m / rho.
+    pub vol: f64,
+}
+
+impl<const D: usize> SolidPoint<D> {
+    /// The view of a particle of velocity `u`, gradient velocity `v_grad`, shifting part
+    /// `du`, mass `m`, density `rho`, pressure `p` and deviatoric stress `s`.
+    #[inline(always)]
+    pub fn new(
+        u: Vector<D>,
+        v_grad: Vector<D>,
+        du: Vector<D>,
+        m: f64,
+        rho: f64,
+        p: f64,
+        s: Matrix<D>,
+    ) -> Self {
+        Self { u, v_grad, du, m, rho, p, s, vol: m / rho }
+    }
+
+    /// The transport velocity u~ = u + du.
+    #[inline(always)]
+    pub fn u_hat(&self) -> Vector<D> {
+        self.u + self.du
+    }
+}
+
+/// Eq. (25), first term: `rho_a V_b u~_ab . grad W`, which is `-rho div(u~)` of eq. (12).
+#[inline(always)]
+pub fn continuity<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> f64 {
+    a.rho * b.vol * (a.u_hat() - b.u_hat()).dot(&ab.dwij)
+}
+
+/// Eq. (25), correction term: `-V_b (rho (u~ - u))_ab . grad W`, which is
+/// `+div(rho (u~ - u))` of eq. (12). Eq. (25) prints a plus sign; the minus follows from
+/// eq. (12) (`shared/SEED-NOTES.md`, "Eq. (25)").
+#[inline(always)]
+pub fn continuity_correction<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> f64 {
+    -b.vol * (a.du * a.rho - b.du * b.rho).dot(&ab.dwij)
+}
+
+/// Eq. (31): one neighbour's share of the velocity gradient,
+/// `-V_b (v_a - v_b) (x) grad W`, entry `(i, j)` approximating `d v_i / d x_j`, with `v`
+/// the particle's [`v_grad`](SolidPoint::v_grad).
+#[inline(always)]
+pub fn velocity_gradient<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> Matrix<D> {
+    (a.v_grad - b.v_grad) * ab.dwij.transpose() * -b.vol
+}
+
+/// Eq. (32), first correction: `-V_b (sigma' (x) (u~ - u))_ab . grad W`, entry `(i, j)`
+/// the sum over `k` of `(sigma'_ij du_k)_ab dW/dx_k`; it is `+d/dx_k (sigma'_ij du_k)` of
+/// eq. (21). Eq. (32) prints a plus sign, the slip of eq. (25)
+/// (`shared/SEED-NOTES.md`, "Eq. (32)").
+#[inline(always)]
+pub fn stress_transport<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> Matrix<D> {
+    (a.s * a.du.dot(&ab.dwij) - b.s * b.du.dot(&ab.dwij)) * -b.vol
+}
+
+/// Eq. (32), second correction, one neighbour's share of the scalar it multiplies
+/// `sigma'_a` by: `V_b (u~ - u)_ab . grad W`, which is `-div(u~ - u)` (eq. 21's
+/// `-sigma' d/dx_k (u~_k - u_k)`; printed correctly).
+#[inline(always)]
+pub fn transport_divergence<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> f64 {
+    b.vol * (a.du - b.du).dot(&ab.dwij)
+}
+
+/// Eq. (4) (and the first terms of eqs. 21 and 32): the Jaumann rate of Hooke's deviatoric
+/// stress, `2G (eps' - tr(eps')/3 I) + sigma' Omega^T + Omega sigma'`, from the velocity
+/// gradient `grad_u` (entry `(i, j)` = `d u_i / d x_j`), with the strain rate
+/// `eps' = (grad_u + grad_u^T)/2` (eq. 5) and the rotation rate
+/// `Omega = (grad_u - grad_u^T)/2` (eq. 6). `sigma'_ik Omega_jk` of eq. (4) is
+/// `(sigma' Omega^T)_ij`.
+#[inline(always)]
+pub fn jaumann_rate<const D: usize>(s: &Matrix<D>, grad_u: &Matrix<D>, shear_modulus: f64) -> Matrix<D> {
+    let eps = (grad_u + grad_u.transpose()) * 0.5;
+    let omega = (grad_u - grad_u.transpose()) * 0.5;
+    let deviator = eps - Matrix::<D>::identity() * (eps.trace() / 3.0);
+    deviator * (2.0 * shear_modulus) + s * omega.transpose() + omega * s
+}
+
+/// Eq. (30) without its artificial viscosity: `-m_b [(p_a/rho_a^2 + p_b/rho_b^2) I
+/// - (sigma'_a/rho_a^2 + sigma'_b/rho_b^2)] grad W`. Monaghan's `Pi_ab` is grouped with
+/// the pressure (`-m_b Pi_ab grad W`,
+/// [`monaghan_values`](super::artificial_viscosity::monaghan_values)), not with the
+/// deviatoric stress as printed (`shared/SEED-NOTES.md`, "Eq. (30)").
+#[inline(always)]
+pub fn momentum<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<D>) -> Vector<D> {
+    let (ia, ib) = (1.0 / (a.rho * a.rho), 1.0 / (b.rho * b.rho));
+    let pressure = ab.dwij * (a.p * ia + b.p * ib);
+    let deviatoric = (a.s * ia + b.s * ib) * ab.dwij;
+    (pressure - deviatoric) * -b.m
+}
+
+/// The second invariant of a deviatoric stress, `J2 = sigma':sigma' / 2` (in 2D plane
+/// strain, of the in-plane components tracked).
+#[inline(always)]
+pub fn j2<const D: usize>(s: &Matrix<D>) -> f64 {
+    0.5 * s.component_mul(s).sum()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pair(xa: [f64; 2], xb: [f64; 2], h: f64) -> Pair<2> {
+        // A made-up kernel: W = 1, (1/r) dW/dr = -2, so grad W = -2 x_ab.
+        let xij = Vector::<2>::from(xa) - Vector::<2>::from(xb);
+        Pair::new(xij, xij.norm_squared(), h, 1.0, -2.0)
+    }
+
+    fn pt(u: [f64; 2], du: [f64; 2], m: f64, rho: f64, p: f64, s: [[f64; 2]; 2]) -> SolidPoint<2> {
+        let s = Matrix::<2>::new(s[0][0], s[0][1], s[1][0], s[1][1]);
+        SolidPoint::new(u.into(), u.into(), du.into(), m, rho, p, s)
+    }
+
+    /// Two particles by hand: x_ab = (0.1, 0), so grad W = (-0.2, 0); b of volume 0.5.
+    /// Every value below is worked out on paper from the formulas of the doc comments.
+    #[test]
+    fn two_particle_hand_values() {
+        let ab = pair([0.1, 0.0], [0.0, 0.0], 0.1);
+        let s_a = [[1.0, 2.0], [2.0, -1.0]];
+        let s_b = [[3.0, 0.0], [0.0, 5.0]];
+        let a = pt([1.0, 2.0], [0.5, 0.0], 1.0, 2.0, 4.0, s_a);
+        let b = pt([0.0, 1.0], [0.0, 0.5], 1.0, 2.0, 8.0, s_b);
+        // u~_a = (1.5, 2), u~_b = (0, 1.5): u~_ab = (1.5, 0.5); . grad W = -0.3;
+        // rho_a V_b = 2 * 0.5 = 1.
+        assert!((continuity(&a, &b, &ab) - -0.3).abs() < 1e-15);
+        // (rho du)_ab = (1, 0) - (0, 1) = (1, -1); . grad W = -0.2; times -V_b = 0.1.
+        assert!((continuity_correction(&a, &b, &ab) - 0.1).abs() < 1e-15);
+        // -V_b u_ab (x) grad W = -0.5 (1, 1)^T (-0.2, 0) = [[0.1, 0], [0.1, 0]].
+        let g = velocity_gradient(&a, &b, &ab);
+        assert!((g - Matrix::<2>::new(0.1, 0.0, 0.1, 0.0)).norm() < 1e-15, "{g}");
+        // du_a . grad W = -0.1, du_b . grad W = 0: -0.5 (sigma_a (-0.1)) = 0.05 sigma_a.
+        let t = stress_transport(&a, &b, &ab);
+        assert!((t - Matrix::<2>::new(0.05, 0.1, 0.1, -0.05)).norm() < 1e-15, "{t}");
+        // V_b (du_a - du_b) . grad W = 0.5 (0.5, -0.5) . (-0.2, 0) = -0.05.
+        assert!((transport_divergence(&a, &b, &ab) - -0.05).abs() < 1e-15);
+        // 1/rho^2 = 1/4: pressure (4 + 8)/4 = 3, deviatoric (s_a + s_b)/4 = [[1, .5], [.5, 1]];
+        // [3 I - that] grad W = [[2, -.5], [-.5, 2]] (-0.2, 0) = (-0.4, 0.1); times -m_b.
+        let f = momentum(&a, &b, &ab);
+        assert!((f - Vector::<2>::new(0.4, -0.1)).norm() < 1e-15, "{f}");
+    }
+
+    /// Eq. (4) by hand: a simple shear `d u_x / d y = 1` of an unstressed particle gives
+    /// `sigma'_xy` rate `G`; a uniform compression gives no deviatoric rate in the
+    /// deviator's trace; the stress rate of a stressed particle under the same shear adds
+    /// the rotation terms.
+    #[test]
+    fn jaumann_rate_by_hand() {
+        let g = 3.0;
+        let shear = Matrix::<2>::new(0.0, 1.0, 0.0, 0.0);
+        let r = jaumann_rate(&Matrix::zeros(), &shear, g);
+        assert!((r - Matrix::<2>::new(0.0, g, g, 0.0)).norm() < 1e-15, "{r}");
+        // Plane strain: tr(eps) = 2 for grad u = I, eps' = I - 2/3 I = I/3, rate 2G/3 I.
+        let r = jaumann_rate(&Matrix::zeros(), &Matrix::<2>::identity(), g);
+        assert!((r - Matrix::<2>::identity() * (2.0 * g / 3.0)).norm() < 1e-15, "{r}");
+        // Omega = [[0, 1/2], [-1/2, 0]]; sigma' = diag(1, -1): sigma' Omega^T + Omega sigma'
+        // = [[0, -1/2], [-1/2, 0]] + [[0, -1/2], [-1/2, 0]] = [[0, -1], [-1, 0]].
+        let s = Matrix::<2>::new(1.0, 0.0, 0.0, -1.0);
+        let r = jaumann_rate(&s, &shear, g);
+        assert!((r - Matrix::<2>::new(0.0, g - 1.0, g - 1.0, 0.0)).norm() < 1e-15, "{r}");
+    }
+
+    /// Objectivity: under a rigid rotation (an antisymmetric velocity gradient) the
+    /// Jaumann rate only rotates the stress, so its invariants do not change. The rate of
+    /// J2 is `sigma' : rate`, which is zero to rounding; integrated over a quarter turn
+    /// (RK4, 400 steps), the trace and J2 keep their values to 1e-10 and the stress turns
+    /// with the body.
+    #[test]
+    fn a_rigid_rotation_leaves_the_stress_invariants_unchanged() {
+        let w = 2.0; // angular velocity: grad u = [[0, -w], [w, 0]]
+        let spin = Matrix::<2>::new(0.0, -w, w, 0.0);
+        let s0 = Matrix::<2>::new(1.5, 0.7, 0.7, -0.4);
+        let rate = |s: &Matrix<2>| jaumann_rate(s, &spin, 10.0);
+        assert!(s0.component_mul(&rate(&s0)).sum().abs() < 1e-14, "d J2/dt = 0");
+        let (t_end, n) = (std::f64::consts::FRAC_PI_2 / w, 400);
+        let dt = t_end / n as f64;
+        let mut s = s0;
+        for _ in 0..n {
+            let k1 = rate(&s);
+            let k2 = rate(&(s + k1 * (0.5 * dt)));
+            let k3 = rate(&(s + k2 * (0.5 * dt)));
+            let k4 = rate(&(s + k3 * dt));
+            s += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (dt / 6.0);
+        }
+        assert!((s.trace() - s0.trace()).abs() < 1e-10);
+        assert!((j2(&s) - j2(&s0)).abs() < 1e-10 * j2(&s0));
+        // A quarter turn: R s0 R^T with R the rotation by pi/2.
+        let rot = Matrix::<2>::new(0.0, -1.0, 1.0, 0.0);
+        let expected = rot * s0 * rot.transpose();
+        assert!((s - expected).norm() < 1e-9, "{s} against {expected}");
+    }
+
+    /// A uniform field gives no rates: the terms are differences over the pair.
+    #[test]
+    fn uniform_fields_give_no_rates() {
+        let ab = pair([0.1, 0.05], [0.0, 0.0], 0.1);
+        let s = [[1.0, 0.3], [0.3, -2.0]];
+        let a = pt([1.0, 2.0], [0.5, 0.1], 1.0, 2.0, 4.0, s);
+        let b = a;
+        assert_eq!(continuity(&a, &b, &ab), 0.0);
+        assert_eq!(continuity_correction(&a, &b, &ab), 0.0);
+        assert_eq!(velocity_gradient(&a, &b, &ab), Matrix::<2>::zeros());
+        assert_eq!(stress_transport(&a, &b, &ab), Matrix::<2>::zeros());
+        assert_eq!(transport_divergence(&a, &b, &ab), 0.0);
+    }
+}

@@ -1,0 +1,310 @@
+//! An elastic solid body (CTVF sec. 2-3): positions, momentum velocity u, transport
+//! velocity u~ (only when its scheme shifts), density, pressure from the state equation
+//! (eq. 8), deviatoric stress sigma' and a `fixed` flag per particle; its material
+//! ([`SolidMaterial`]: E, nu, rho0, giving K, c0 and G), its time-step limit (eq. 62) and
+//! its kick-drift-kick updates (eqs. 54-60, with eq. 58 for the stress).
+//!
+//! **Clamps.** A clamped region is made of particles of the same body flagged `fixed`:
+//! they take part in every sum as neighbours and their density, pressure and deviatoric
+//! stress evolve by the same rates as the others' (a continuum held at u = 0), but their
+//! accelerations and shifting are zero, so they never move. This is the set-up of Gray et
+//! al. (2001), which the paper's oscillating plate (sec. 4.4, fig. 17) follows; it needs no
+//! extrapolation of the stress onto a separate boundary (eq. 53).
+
+use crate::solver::integrator;
+use crate::solver::math::{Matrix, Vector};
+use crate::solver::scheme::SolidScheme;
+use serde::{Deserialize, Serialize};
+
+/// The material of an elastic solid: Young's modulus, Poisson's ratio and reference
+/// density, from which the bulk modulus, the speed of sound and the shear modulus follow.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SolidMaterial {
+    /// Young's modulus E (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson's ratio nu.
+    pub poisson_ratio: f64,
+    /// Reference density rho0 (kg/m^3).
+    pub rho0: f64,
+}
+
+impl SolidMaterial {
+    /// A material, refused (naming the quantity and its value) unless `E > 0`,
+    /// `-1 < nu < 0.5` and `rho0 > 0`, all finite.
+    pub fn new(youngs_modulus: f64, poisson_ratio: f64, rho0: f64) -> Result<Self, String> {
+        if !(youngs_modulus > 0.0 && youngs_modulus.is_finite()) {
+            return Err(format!("Young's modulus {youngs_modulus} must be positive"));
+        }
+        if !(poisson_ratio > -1.0 && poisson_ratio < 0.5) {
+            return Err(format!(
+                "Poisson's ratio {poisson_ratio} must lie in (-1, 0.5): at 0.5 the bulk modulus is infinite, at -1 the shear modulus"
+            ));
+        }
+        if !(rho0 > 0.0 && rho0.is_finite()) {
+            return Err(format!("density {rho0} must be positive"));
+        }
+        Ok(Self { youngs_modulus, poisson_ratio, rho0 })
+    }
+
+    /// Bulk modulus `K = E / (3 (1 - 2 nu)) = rho0 c0^2` (eq. 8 and the text below it).
+    pub fn bulk_modulus(&self) -> f64 {
+        self.youngs_modulus / (3.0 * (1.0 - 2.0 * self.poisson_ratio))
+    }
+
+    /// Speed of sound `c0 = sqrt(E / (3 (1 - 2 nu) rho0))` (the text below eq. 8).
+    pub fn c0(&self) -> f64 {
+        (self.bulk_modulus() / self.rho0).sqrt()
+    }
+
+    /// Shear modulus `G = E / (2 (1 + nu))` (eq. 4).
+    pub fn shear_modulus(&self) -> f64 {
+        self.youngs_modulus / (2.0 * (1.0 + self.poisson_ratio))
+    }
+
+    /// The state equation (8): `p = K (rho / rho0 - 1)`.
+    #[inline(always)]
+    pub fn pressure(&self, rho: f64) -> f64 {
+        self.bulk_modulus() * (rho / self.rho0 - 1.0)
+    }
+}
+
+/// Initial values for a solid body, one entry per particle.
+#[derive(Clone, Debug, Default)]
+pub struct SolidInit<const D: usize> {
+    /// Positions.
+    pub x: Vec<Vector<D>>,
+    /// Velocities.
+    pub u: Vec<Vector<D>>,
+    /// Masses.
+    pub m: Vec<f64>,
+    /// Densities.
+    pub rho: Vec<f64>,
+    /// Held in place (a clamp).
+    pub fixed: Vec<bool>,
+}
+
+/// State of one elastic solid (struct of arrays), in the order its particles were given.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ElasticSolid<const D: usize> {
+    /// Body name.
+    pub name: String,
+    /// Smoothing length.
+    pub h: f64,
+    /// The material.
+    pub material: SolidMaterial,
+    /// Its equations.
+    pub physics: SolidScheme,
+    /// Positions.
+    pub x: Vec<Vector<D>>,
+    /// Momentum velocity u.
+    pub u: Vec<Vector<D>>,
+    /// Transport velocity u~ (eq. 33): only when the scheme shifts.
+    pub u_hat: Option<Vec<Vector<D>>>,
+    /// Masses.
+    pub m: Vec<f64>,
+    /// Densities.
+    pub rho: Vec<f64>,
+    /// Pressures (eq. 8).
+    pub p: Vec<f64>,
+    /// Deviatoric stress sigma' (symmetric).
+    pub s: Vec<Matrix<D>>,
+    /// Held in place (a clamp): zero acceleration and shifting.
+    pub fixed: Vec<bool>,
+}
+
+/// Time derivatives of a solid body, owned by the simulation.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct SolidRates<const D: usize> {
+    /// du/dt (eq. 30); zero for fixed particles.
+    pub du: Vec<Vector<D>>,
+    /// d rho/dt (eq. 25).
+    pub drho: Vec<f64>,
+    /// d sigma'/dt (eq. 32).
+    pub ds: Vec<Matrix<D>>,
+    /// Homogenisation acceleration (du/dt)_c (eq. 36), when the scheme shifts.
+    pub a_c: Vec<Vector<D>>,
+    /// The step eq. (36) divided (du/dt)_c by (see
+    /// [`FluidRates::a_c_dt`](super::FluidRates::a_c_dt)).
+    pub a_c_dt: Option<f64>,
+}
+
+impl<const D: usize> SolidRates<D> {
+    /// Zeroed rates for the particles of `solid` (the shifting only if it shifts).
+    pub fn of(solid: &ElasticSolid<D>) -> Self {
+        let n = solid.len();
+        Self {
+            du: vec![Vector::zeros(); n],
+            drho: vec![0.0; n],
+            ds: vec![Matrix::zeros(); n],
+            a_c: if solid.physics.shifting.is_some() { vec![Vector::zeros(); n] } else { Vec::new() },
+            a_c_dt: None,
+        }
+    }
+}
+
+impl<const D: usize> ElasticSolid<D> {
+    /// A solid body from initial values, stress free, its pressure from the state equation.
+    /// Errors name the body and the offending field.
+    pub fn new(
+        name: &str,
+        h: f64,
+        init: SolidInit<D>,
+        material: SolidMaterial,
+        physics: SolidScheme,
+    ) -> Result<Self, String> {
+        let n = init.x.len();
+        if n == 0 {
+            return Err(format!("solid `{name}`: no particles"));
+        }
+        if !(h > 0.0 && h.is_finite()) {
+            return Err(format!("solid `{name}`: smoothing length h = {h} must be positive"));
+        }
+        for (field, len) in
+            [("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("fixed", init.fixed.len())]
+        {
+            if len != n {
+                return Err(format!("solid `{name}`: {field} has {len} entries for {n} particles"));
+            }
+        }
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if let Some(i) = init.m.iter().position(|&m| !(m > 0.0)) {
+            return Err(format!("solid `{name}`: particle {i} has non-positive mass {}", init.m[i]));
+        }
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
+            return Err(format!("solid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
+        }
+        let mut u = init.u;
+        for (u, &fixed) in u.iter_mut().zip(&init.fixed) {
+            if fixed {
+                *u = Vector::zeros();
+            }
+        }
+        let u_hat = physics.shifting.is_some().then(|| u.clone());
+        let p = init.rho.iter().map(|&r| material.pressure(r)).collect();
+        Ok(Self {
+            name: name.into(),
+            h,
+            material,
+            physics,
+            x: init.x,
+            u,
+            u_hat,
+            m: init.m,
+            rho: init.rho,
+            p,
+            s: vec![Matrix::zeros(); n],
+            fixed: init.fixed,
+        })
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// Whether the body has no particles (never true for a constructed body).
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// The transport velocity if declared, else the momentum velocity.
+    pub fn u_hat(&self) -> &[Vector<D>] {
+        self.u_hat.as_deref().unwrap_or(&self.u)
+    }
+
+    /// Largest particle speed |u|.
+    pub fn max_speed(&self) -> f64 {
+        self.u.iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()
+    }
+
+    /// The time-step limit of eq. (62), `cfl h / (c0 + |u|_max)` (the paper's factor is
+    /// 0.25), with the body's own largest speed.
+    pub fn dt_limit(&self, cfl: f64) -> f64 {
+        cfl * self.h / (self.material.c0() + self.max_speed())
+    }
+
+    /// The opening half kick (eq. 54) and the transport velocity (eq. 55). Fixed
+    /// particles have zero rates, so they stay at rest.
+    pub fn kick_open(&mut self, r: &SolidRates<D>, dt: f64) {
+        integrator::kick_transport(&mut self.u, self.u_hat.as_deref_mut(), &r.du, &r.a_c, r.a_c_dt, dt);
+    }
+
+    /// The update of density, pressure and deviatoric stress over `dt` (eqs. 56, 8, 58)
+    /// by rates evaluated at the start of the step with the half-step velocities (sec. 3.7).
+    pub fn update_state(&mut self, r: &SolidRates<D>, dt: f64) {
+        let material = self.material;
+        for ((rho, p), drho) in self.rho.iter_mut().zip(&mut self.p).zip(&r.drho) {
+            *rho += dt * drho;
+            *p = material.pressure(*rho);
+        }
+        for (s, ds) in self.s.iter_mut().zip(&r.ds) {
+            *s += ds * dt;
+        }
+    }
+
+    /// The drift of eq. (59), with the transport velocity if there is one.
+    pub fn drift(&mut self, dt: f64) {
+        integrator::drift(&mut self.x, self.u_hat.as_deref().unwrap_or(&self.u), dt);
+    }
+
+    /// The closing half kick (eq. 60).
+    pub fn kick_close(&mut self, r: &SolidRates<D>, dt: f64) {
+        integrator::kick(&mut self.u, &r.du, dt);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::solver::scheme::{Pst, SolidSchemeName, SolidSettings};
+
+    fn physics() -> SolidScheme {
+        let s = SolidSettings {
+            pst: Pst::Sun,
+            corrections: true,
+            alpha: 1.0,
+            u_ref: 1.0,
+            w_dx: 1.0,
+            gravity: [0.0; 3],
+        };
+        SolidSchemeName::Ctvf.solid_scheme(&s).unwrap()
+    }
+
+    /// The oscillating plate's material (CTVF sec. 4.4): c0 = sqrt(E / (3 (1 - 2 nu) rho0)).
+    #[test]
+    fn material_constants() {
+        let m = SolidMaterial::new(2.0e6, 0.3975, 1000.0).unwrap();
+        let k = 2.0e6 / (3.0 * (1.0 - 0.795));
+        assert!((m.bulk_modulus() - k).abs() < 1e-9 * k);
+        assert!((m.c0() - (k / 1000.0).sqrt()).abs() < 1e-12);
+        assert!((m.c0() - 57.03).abs() < 0.01, "{}", m.c0());
+        assert!((m.shear_modulus() - 2.0e6 / 2.795).abs() < 1e-6);
+        assert_eq!(m.pressure(1000.0), 0.0);
+        assert!(m.pressure(1001.0) > 0.0, "compression raises the pressure");
+        assert!(SolidMaterial::new(1.0, 0.5, 1.0).unwrap_err().contains("Poisson's ratio 0.5"));
+        assert!(SolidMaterial::new(0.0, 0.3, 1.0).unwrap_err().contains("Young's modulus 0"));
+        assert!(SolidMaterial::new(1.0, 0.3, -1.0).unwrap_err().contains("density -1"));
+    }
+
+    #[test]
+    fn fixed_particles_start_at_rest_and_fields_follow_the_scheme() {
+        let init = SolidInit {
+            x: vec![Vector::<2>::zeros(), Vector::<2>::new(1.0, 0.0)],
+            u: vec![Vector::<2>::new(1.0, 0.0); 2],
+            m: vec![1.0; 2],
+            rho: vec![1000.0; 2],
+            fixed: vec![true, false],
+        };
+        let s =
+            ElasticSolid::new("plate", 0.1, init, SolidMaterial::new(1.0, 0.3, 1000.0).unwrap(), physics())
+                .unwrap();
+        assert_eq!(s.u[0], Vector::<2>::zeros());
+        assert_eq!(s.u[1], Vector::<2>::new(1.0, 0.0));
+        assert_eq!(s.u_hat.as_ref().unwrap().len(), 2);
+        let bad = SolidInit { fixed: vec![false], ..SolidInit::<2>::default() };
+        assert!(ElasticSolid::new("plate", 0.1, bad, s.material, physics())
+            .unwrap_err()
+            .contains("no particles"));
+    }
+}
