@@ -850,6 +850,7 @@ source = "The paper's words."
             reason: None,
             step: None,
             metrics: [("l1_velocity_mean".to_string(), l1)].into(),
+            undefined_metrics: Vec::new(),
             provenance: Provenance::now(chrono::Utc::now()),
         }
         .write(&dir)

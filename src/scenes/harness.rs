@@ -350,9 +350,14 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
         Outcome::Failed(r) => (Status::Failed, Some(r.clone()), BTreeMap::new()),
     };
     let mut s = summary(entry, params, scene.as_ref(), status, reason, metrics, started, t0, stepping);
-    if let Outcome::Diverged(d) = &outcome {
-        s.step = Some(d.step);
-        s.final_time = d.time;
+    match &outcome {
+        Outcome::Diverged(d) => {
+            s.step = Some(d.step);
+            s.final_time = d.time;
+        }
+        // Every declared metric is named: one the run cannot define as `null`.
+        Outcome::Completed(_) => s = s.with_undefined(entry.metrics),
+        Outcome::Failed(_) => {}
     }
     let written = s.write(out).map_err(|e| io_err(&summary_path, e));
     if written.is_ok() && status != Status::Failed {
@@ -423,6 +428,7 @@ fn summary(
         reason,
         step: None,
         metrics,
+        undefined_metrics: Vec::new(),
         provenance: Provenance::now(started),
     }
 }

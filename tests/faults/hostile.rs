@@ -51,8 +51,12 @@ fn judge(entry: &SceneEntry, key: &str, ran: &Ran, out: &Path) -> Result<&'stati
             if metrics.is_empty() {
                 return Err("completed without metrics".into());
             }
+            // A `null` stands only for a metric the summary lists as undefined by the run.
+            let undefined =
+                |m: &str| s["undefined_metrics"].as_array().is_some_and(|u| u.iter().any(|n| n == m));
             for (m, v) in metrics {
-                if !entry.metrics.contains(&m.as_str()) || !v.as_f64().is_some_and(f64::is_finite) {
+                let defined = v.as_f64().is_some_and(f64::is_finite) || (v.is_null() && undefined(m));
+                if !entry.metrics.contains(&m.as_str()) || !defined {
                     return Err(format!("completed with metric `{m}` = {v}"));
                 }
             }

@@ -654,6 +654,7 @@ source = "A marker's size."
             reason: None,
             step: None,
             metrics: [("l1_velocity_final".to_string(), l1)].into(),
+            undefined_metrics: Vec::new(),
             provenance: Provenance::now(chrono::Utc::now()),
         }
     }
@@ -733,6 +734,7 @@ source = "A marker's size."
             reason: Some("NaN".into()),
             step: Some(4),
             metrics: BTreeMap::new(),
+            undefined_metrics: Vec::new(),
             ..completed(p.cases[1].params.to_json(), 256, 0.0)
         }
         .write(&e.dir)

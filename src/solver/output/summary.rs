@@ -148,13 +148,33 @@ pub struct Summary {
     /// The step at which it diverged.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub step: Option<u64>,
-    /// Named error norms and validation figures.
+    /// Named error norms and validation figures: finite, but for the NaN that stands for each
+    /// name of [`undefined_metrics`](Self::undefined_metrics) until written (as `null`; read
+    /// back, it is left out).
+    #[serde(serialize_with = "with_undefined", deserialize_with = "defined_only")]
     pub metrics: BTreeMap<String, f64>,
+    /// The scene's metrics this run cannot define (the period of a run shorter than half a
+    /// period): named in `metrics` as `null` so that every declared name is in the file, and
+    /// listed here so that a `null` is never mistaken for a value that blew up.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub undefined_metrics: Vec<String>,
     /// Provenance.
     pub provenance: Provenance,
 }
 
 impl Summary {
+    /// Names every metric of `declared` the run left undefined: listed in
+    /// [`undefined_metrics`](Self::undefined_metrics) and written as `null` in `metrics`.
+    pub fn with_undefined(mut self, declared: &[&str]) -> Self {
+        for &m in declared {
+            if !self.metrics.contains_key(m) {
+                self.metrics.insert(m.to_string(), f64::NAN);
+                self.undefined_metrics.push(m.to_string());
+            }
+        }
+        self
+    }
+
     /// Writes `DIR/summary.json` atomically.
     pub fn write(&self, dir: &Path) -> std::io::Result<()> {
         let json = serde_json::to_string_pretty(self).expect("summary serialises");
@@ -203,4 +223,18 @@ mod tests {
         let back: Provenance = serde_json::from_value(v).unwrap();
         assert_eq!(back.slurm, p.slurm);
     }
+}
+
+/// Writes [`Summary::metrics`] with the NaN of an undefined metric
+/// ([`Summary::with_undefined`]) as `null`.
+fn with_undefined<S: serde::Serializer>(m: &BTreeMap<String, f64>, s: S) -> Result<S::Ok, S::Error> {
+    let out: BTreeMap<&str, Option<f64>> =
+        m.iter().map(|(k, v)| (k.as_str(), v.is_finite().then_some(*v))).collect();
+    out.serialize(s)
+}
+
+/// Reads [`Summary::metrics`], leaving out the `null`s of undefined metrics.
+fn defined_only<'de, D: serde::Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
+    let m = BTreeMap::<String, Option<f64>>::deserialize(d)?;
+    Ok(m.into_iter().filter_map(|(k, v)| Some((k, v?))).collect())
 }
