@@ -189,6 +189,20 @@ impl Summary {
     }
 }
 
+/// Writes [`Summary::metrics`] with the NaN of an undefined metric
+/// ([`Summary::with_undefined`]) as `null`.
+fn with_undefined<S: serde::Serializer>(m: &BTreeMap<String, f64>, s: S) -> Result<S::Ok, S::Error> {
+    let out: BTreeMap<&str, Option<f64>> =
+        m.iter().map(|(k, v)| (k.as_str(), v.is_finite().then_some(*v))).collect();
+    out.serialize(s)
+}
+
+/// Reads [`Summary::metrics`], leaving out the `null`s of undefined metrics.
+fn defined_only<'de, D: serde::Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
+    let m = BTreeMap::<String, Option<f64>>::deserialize(d)?;
+    Ok(m.into_iter().filter_map(|(k, v)| Some((k, v?))).collect())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -223,18 +237,4 @@ mod tests {
         let back: Provenance = serde_json::from_value(v).unwrap();
         assert_eq!(back.slurm, p.slurm);
     }
-}
-
-/// Writes [`Summary::metrics`] with the NaN of an undefined metric
-/// ([`Summary::with_undefined`]) as `null`.
-fn with_undefined<S: serde::Serializer>(m: &BTreeMap<String, f64>, s: S) -> Result<S::Ok, S::Error> {
-    let out: BTreeMap<&str, Option<f64>> =
-        m.iter().map(|(k, v)| (k.as_str(), v.is_finite().then_some(*v))).collect();
-    out.serialize(s)
-}
-
-/// Reads [`Summary::metrics`], leaving out the `null`s of undefined metrics.
-fn defined_only<'de, D: serde::Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
-    let m = BTreeMap::<String, Option<f64>>::deserialize(d)?;
-    Ok(m.into_iter().filter_map(|(k, v)| Some((k, v?))).collect())
 }
