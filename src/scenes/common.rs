@@ -521,9 +521,9 @@ pub fn shepard(f: &Fluid<2>, kernel: &Kernel, q: Vector<2>, value: impl Fn(usize
     (den > 0.0).then(|| num / den)
 }
 
-/// The [`SceneRun`](super::SceneRun) methods every scene forwards to its `sim` field
-/// (a `Simulation<D>`): particle count, time, steps, advancing.
-macro_rules! forward_to_sim {
+/// The [`SceneRun`](super::SceneRun) counts every scene forwards to its `sim` field
+/// (a `Simulation<D>`): particles, time, steps.
+macro_rules! forward_counts {
     () => {
         fn particles(&self) -> usize {
             $crate::scenes::common::particle_count(&self.sim)
@@ -540,6 +540,14 @@ macro_rules! forward_to_sim {
         fn wavefront_steps(&self) -> u64 {
             self.sim.wavefront_steps()
         }
+    };
+}
+pub(crate) use forward_counts;
+
+/// The counts of [`forward_counts`] and an advance that is `Simulation::advance`'s.
+macro_rules! forward_to_sim {
+    () => {
+        $crate::scenes::common::forward_counts!();
         fn advance(
             &mut self,
             t_stop: f64,

@@ -13,6 +13,7 @@ pub mod hydrostatic_tank;
 pub mod oscillating_plate;
 pub mod params;
 pub mod progress;
+pub mod solid_common;
 pub mod tank;
 pub mod taylor_green;
 

@@ -34,12 +34,13 @@
 
 use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
+use super::solid_common::{
+    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
+};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::fracture;
-use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::scheme::{Pst, SolidScheme, SolidSchemeName, SolidSettings};
 use crate::solver::simulation::Simulation;
 use crate::solver::systems::{ElasticSolid, SolidInit, SolidMaterial};
 use std::collections::BTreeMap;
@@ -59,9 +60,6 @@ const PAPER_PLATE: (f64, f64, f64, f64, f64) = (0.2, 0.02, 2.0e6, 0.3975, 1000.0
 
 /// The body's name.
 const PLATE: &str = "plate";
-
-/// The most steps a run may need (as the fluid scenes' bound).
-const MAX_STEPS: f64 = 1e9;
 
 /// The registry entry.
 pub const ENTRY: SceneEntry = SceneEntry {
@@ -88,37 +86,23 @@ fn params() -> Vec<Spec> {
         Spec::float("vf", 0.05, Bound::Positive, "initial tip speed over c0, V_f of sec. 4.4"),
         Spec::float("length", 0.2, Bound::Positive, "plate length L (m)"),
         Spec::float("height", 0.02, Bound::Positive, "plate height H (m)"),
-        Spec::float("dx", 0.002, Bound::Positive, "particle spacing (m); the paper's is 0.002"),
-        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
-        Spec::float("youngs_modulus", 2.0e6, Bound::Positive, "Young's modulus E (Pa)"),
-        Spec::float("poisson_ratio", 0.3975, Bound::None, "Poisson's ratio nu, in (-1, 0.5)"),
-        Spec::float("density", 1000.0, Bound::Positive, "reference density rho0 (kg/m^3)"),
-        Spec::float("alpha", 1.0, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
-        Spec::choice(
-            "scheme",
-            SolidSchemeName::NAMES,
-            "ctvf",
-            "solid scheme: ctvf (eq. 31 of u, corrections) or gtvf (of u~, none)",
-        ),
-        Spec::choice("pst", &["sun", "none"], "sun", "particle shifting: Sun 2019 (eq. 36) or none"),
-        Spec::choice(
-            "corrections",
-            &["all", "none"],
-            "all",
-            "the CTVF correction terms of eqs. (25) and (32) (ctvf)",
-        ),
     ];
+    v.extend(solid_params(&SolidDefaults {
+        dx: 0.002,
+        youngs_modulus: 2.0e6,
+        poisson_ratio: 0.3975,
+        density: 1000.0,
+        yield_stress: None,
+        alpha: 1.0,
+        pst: "sun",
+    }));
     v.extend(common_params(0.3));
     v
 }
 
 /// What the parameters make, once every check that needs no particle has passed.
 struct Setup {
-    material: SolidMaterial,
-    scheme: SolidScheme,
-    kernel: Kernel,
-    dx: f64,
-    h: f64,
+    solid: SolidSetup,
     /// Plate columns and rows, and clamp layers.
     nx: usize,
     ny: usize,
@@ -127,22 +111,18 @@ struct Setup {
 
 fn setup(p: &Params) -> Result<Setup, String> {
     let scene = "oscillating_plate";
-    let bad = |key: &str, why: String| {
-        Err(format!("scene `{scene}`: parameter `{key}` = {:?}: {why}", p.float(key)))
-    };
-    let nu = p.float("poisson_ratio");
-    if !(nu > -1.0 && nu < 0.5) {
-        return bad(
-            "poisson_ratio",
-            "must lie in (-1, 0.5): at 0.5 the bulk modulus is infinite, at -1 the shear modulus".into(),
-        );
-    }
     if p.float("vf") >= 1.0 {
-        return bad("vf", "must be below 1: the tip would start at the speed of sound".into());
+        return Err(format!(
+            "scene `{scene}`: parameter `vf` = {:?}: must be below 1: the tip would start at the speed of sound",
+            p.float("vf")
+        ));
     }
-    let material = SolidMaterial::new(p.float("youngs_modulus"), nu, p.float("density"))
-        .map_err(|e| format!("scene `{scene}`: {e}"))?;
-    let dx = p.float("dx");
+    let c0 = SolidMaterial::new(p.float("youngs_modulus"), p.float("poisson_ratio"), p.float("density"))
+        .map(|m| m.c0())
+        .unwrap_or(0.0);
+    let u = p.float("vf") * c0;
+    let solid = solid_setup(scene, p, u, u, [0.0; 3])?;
+    let dx = solid.dx;
     let (l, hp) = (p.float("length"), p.float("height"));
     // In floating point first: a spacing of 1e-300 m must not overflow a count.
     let (nxf, nyf) = ((l / dx).round(), (hp / dx).round());
@@ -150,43 +130,9 @@ fn setup(p: &Params) -> Result<Setup, String> {
     if nyf < 2.0 || nxf < 4.0 {
         return Err(format!("scene `{scene}`: {plate} has fewer than 4 x 2 particles"));
     }
-    if nxf * nyf > 5e6 {
-        return Err(format!("scene `{scene}`: {plate} makes {:.3e} particles: more than 5e6", nxf * nyf));
-    }
-    let (nx, ny) = (nxf as usize, nyf as usize);
-    let hdx = p.float("hdx");
-    if !(0.5..=3.0).contains(&hdx) {
-        return bad(
-            "hdx",
-            "must lie in [0.5, 3]: the kernel must reach the nearest particles, and the clamp its support"
-                .into(),
-        );
-    }
-    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
-    let h = hdx * dx;
-    let layers = (kernel.support() * h / dx).ceil() as usize;
-    // Eq. (62) at the initial speed: a run of more steps than any machine takes is refused.
-    let dt = p.float("cfl") * h / (material.c0() * (1.0 + p.float("vf")));
-    let steps = p.float("tf") / dt;
-    if steps.is_nan() || steps > MAX_STEPS {
-        return Err(format!(
-            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, h = `hdx` `dx`: more than {MAX_STEPS:e}",
-            p.float("tf"),
-            material.c0()
-        ));
-    }
-    let pst = Pst::from_name(p.str("pst")).expect("checked choice");
-    let name = SolidSchemeName::from_name(p.str("scheme")).expect("checked choice");
-    let settings = SolidSettings {
-        pst,
-        corrections: p.str("corrections") == "all",
-        alpha: p.float("alpha"),
-        u_ref: p.float("vf") * material.c0(),
-        w_dx: kernel.w(dx, h),
-        gravity: [0.0; 3],
-    };
-    let scheme = name.solid_scheme(&settings).map_err(|e| format!("scene `{scene}`: {e}"))?;
-    Ok(Setup { material, scheme, kernel, dx, h, nx, ny, layers })
+    check_count(scene, &plate, nxf * nyf)?;
+    let layers = solid.support_layers();
+    Ok(Setup { solid, nx: nxf as usize, ny: nyf as usize, layers })
 }
 
 /// Eq. (67): the shape of the first bending mode of a clamped-free plate, `k = kL / L`.
@@ -233,7 +179,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 }
 
 fn plate(p: &Params) -> Result<Plate, String> {
-    let Setup { material, scheme, kernel, dx, h, nx, ny, layers } = setup(p)?;
+    let Setup { solid: SolidSetup { material, scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
     let (l, hp) = (nx as f64 * dx, ny as f64 * dx);
     let (k, c0, vf) = (KL / l, material.c0(), p.float("vf"));
     let f_l = mode_shape(l, k, l);
@@ -289,7 +235,7 @@ impl Plate {
     }
 
     /// Records a zero crossing of the tip between the last step and this one.
-    fn follow_tip(&mut self) {
+    fn after_step(&mut self) {
         let (t1, y1) = (self.sim.time(), self.tip_y());
         let (t0, y0) = self.last;
         if t1 > 0.0 && ((y0 > 0.0 && y1 <= 0.0) || (y0 < 0.0 && y1 >= 0.0)) {
@@ -318,42 +264,7 @@ impl Plate {
 }
 
 impl SceneRun for Plate {
-    fn particles(&self) -> usize {
-        super::common::particle_count(&self.sim)
-    }
-    fn body_particles(&self) -> Vec<(String, usize)> {
-        super::common::body_particles(&self.sim)
-    }
-    fn time(&self) -> f64 {
-        self.sim.time()
-    }
-    fn steps(&self) -> u64 {
-        self.sim.steps()
-    }
-    fn wavefront_steps(&self) -> u64 {
-        self.sim.wavefront_steps()
-    }
-    fn advance(
-        &mut self,
-        t_stop: f64,
-        t_end: f64,
-        on_step: &mut dyn FnMut(f64, u64) -> bool,
-    ) -> Result<bool, crate::solver::simulation::Divergence> {
-        // Step by step, to follow the tip's crossings at every step.
-        let eps = 1e-12 * t_end.abs().max(1.0);
-        loop {
-            let now = self.sim.time();
-            if now >= t_stop - eps || t_end - now <= eps {
-                return Ok(true);
-            }
-            // As `Simulation::advance` does: only the step that would pass t_end is shortened.
-            self.sim.step(t_end - now)?;
-            self.follow_tip();
-            if !on_step(self.sim.time(), self.sim.steps()) {
-                return Ok(false);
-            }
-        }
-    }
+    forward_stepwise!();
     fn plan(&self) -> String {
         plan(
             &self.sim,

@@ -31,6 +31,9 @@ pub struct SolidPoint<const D: usize> {
     pub s: Matrix<D>,
     /// Volume m / rho.
     pub vol: f64,
+    /// Monaghan's artificial stress R / rho^2 of the particle ([`artificial_stress`]);
+    /// zero unless the scheme has it.
+    pub r_art: Matrix<D>,
 }
 
 impl<const D: usize> SolidPoint<D> {
@@ -46,7 +49,13 @@ impl<const D: usize> SolidPoint<D> {
         p: f64,
         s: Matrix<D>,
     ) -> Self {
-        Self { u, v_grad, du, m, rho, p, s, vol: m / rho }
+        Self { u, v_grad, du, m, rho, p, s, vol: m / rho, r_art: Matrix::zeros() }
+    }
+
+    /// The same particle with its artificial stress computed ([`artificial_stress`]).
+    #[inline(always)]
+    pub fn with_artificial_stress(self, eps: f64) -> Self {
+        Self { r_art: artificial_stress(&self.s, self.p, self.rho, eps), ..self }
     }
 
     /// The transport velocity u~ = u + du.
@@ -129,6 +138,55 @@ pub fn j2<const D: usize>(s: &Matrix<D>) -> f64 {
     0.5 * s.component_mul(s).sum()
 }
 
+/// The radial return of an elastic-perfectly-plastic material onto the von Mises yield
+/// surface (CTVF sec. 4.7): `sigma' <- sqrt(beta) sigma'` with
+/// `beta = min(Y0^2 / (3 J2), 1)`. The paper prints the factor as beta; scaling sigma' by f
+/// scales J2 by f^2, so the return onto `sqrt(3 J2) = Y0` takes sqrt(beta)
+/// (`shared/SEED-NOTES.md`, "Section 4.7").
+#[inline(always)]
+pub fn radial_return<const D: usize>(s: &Matrix<D>, y0: f64) -> Matrix<D> {
+    let j2 = j2(s);
+    if 3.0 * j2 > y0 * y0 {
+        s * (y0 * y0 / (3.0 * j2)).sqrt()
+    } else {
+        *s
+    }
+}
+
+/// The von Mises stress `sqrt(3 J2)` of a deviatoric stress.
+#[inline(always)]
+pub fn von_mises<const D: usize>(s: &Matrix<D>) -> f64 {
+    (3.0 * j2(s)).sqrt()
+}
+
+/// Monaghan's artificial stress (Monaghan 2000; Gray, Monaghan & Swift 2001, eqs. 4.7-4.9)
+/// divided by rho^2: in the principal frame of the total stress `sigma = -p I + sigma'`,
+/// `R_ii = -eps sigma_ii / rho^2` where `sigma_ii > 0` (tension) and 0 where not, rotated
+/// back. It repels particles that tension would pull into clumps (the tensile instability).
+pub fn artificial_stress<const D: usize>(s: &Matrix<D>, p: f64, rho: f64, eps: f64) -> Matrix<D> {
+    let sigma = s - Matrix::<D>::identity() * p;
+    // nalgebra's eigen-decomposition of a const-generic D x D matrix needs bounds a
+    // const D does not meet: decompose a dynamic copy (gray is a comparison scheme).
+    let eig = nalgebra::DMatrix::from_column_slice(D, D, sigma.as_slice()).symmetric_eigen();
+    let r = eig.eigenvalues.map(|l| if l > 0.0 { -eps * l / (rho * rho) } else { 0.0 });
+    let q = Matrix::<D>::from_column_slice(eig.eigenvectors.as_slice());
+    q * Matrix::<D>::from_diagonal(&Vector::<D>::from_column_slice(r.as_slice())) * q.transpose()
+}
+
+/// The artificial-stress term of Gray et al. (2001) eq. (4.10) in the momentum equation:
+/// `m_b (R_a/rho_a^2 + R_b/rho_b^2) f_ab^n grad W`, `f_ab = W_ab / W(dx)`.
+#[inline(always)]
+pub fn artificial_stress_momentum<const D: usize>(
+    a: &SolidPoint<D>,
+    b: &SolidPoint<D>,
+    ab: &Pair<D>,
+    w_dx: f64,
+    n: i32,
+) -> Vector<D> {
+    let f = (ab.wij / w_dx).powi(n);
+    (a.r_art + b.r_art) * ab.dwij * (b.m * f)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -142,6 +200,39 @@ mod tests {
     fn pt(u: [f64; 2], du: [f64; 2], m: f64, rho: f64, p: f64, s: [[f64; 2]; 2]) -> SolidPoint<2> {
         let s = Matrix::<2>::new(s[0][0], s[0][1], s[1][0], s[1][1]);
         SolidPoint::new(u.into(), u.into(), du.into(), m, rho, p, s)
+    }
+
+    /// The radial return (sec. 4.7) puts any stress beyond the yield surface on it, keeps
+    /// its direction, and leaves a stress inside untouched.
+    #[test]
+    fn radial_return_caps_the_von_mises_stress_at_y0() {
+        let y0 = 3.0e8;
+        let inside = Matrix::<2>::new(1.0e8, 2.0e7, 2.0e7, -5.0e7);
+        assert_eq!(radial_return(&inside, y0), inside);
+        let beyond = inside * 10.0;
+        let r = radial_return(&beyond, y0);
+        assert!((von_mises(&r) - y0).abs() < 1e-9 * y0, "{}", von_mises(&r));
+        let ratio = r.component_div(&beyond);
+        assert!(ratio.iter().all(|&f| (f - ratio[0]).abs() < 1e-12), "direction kept");
+    }
+
+    /// Artificial stress by hand: a uniaxial tension sigma_xx = 4 (p = 0, rho = 2) gives
+    /// R_xx = -eps 4 / 4 = -eps and nothing else; a compression gives none; rotated by 45
+    /// degrees, R rotates with it.
+    #[test]
+    fn artificial_stress_acts_on_tension_only() {
+        let eps = 0.3;
+        let tension = Matrix::<2>::new(4.0, 0.0, 0.0, 0.0);
+        let r = artificial_stress(&tension, 0.0, 2.0, eps);
+        assert!((r - Matrix::<2>::new(-eps, 0.0, 0.0, 0.0)).norm() < 1e-14, "{r}");
+        assert_eq!(artificial_stress(&(-tension), 0.0, 2.0, eps), Matrix::<2>::zeros());
+        // p = -4 is a tension of 4 in both directions.
+        let r = artificial_stress(&Matrix::<2>::zeros(), -4.0, 2.0, eps);
+        assert!((r - Matrix::<2>::identity() * -eps).norm() < 1e-14, "{r}");
+        let q = nalgebra::Rotation2::new(std::f64::consts::FRAC_PI_4).into_inner();
+        let r = artificial_stress(&(q * tension * q.transpose()), 0.0, 2.0, eps);
+        let want = q * Matrix::<2>::new(-eps, 0.0, 0.0, 0.0) * q.transpose();
+        assert!((r - want).norm() < 1e-14, "{r} against {want}");
     }
 
     /// Two particles by hand: x_ab = (0.1, 0), so grad W = (-0.2, 0); b of volume 0.5.

@@ -114,6 +114,8 @@ pub struct AccelTerms {
     pub viscosity: Option<(f64, f64)>,
     /// Sun's shifting `(W(dx), R, n)`, eq. (36).
     pub sun: Option<(f64, f64, i32)>,
+    /// Monaghan's artificial stress `(W(dx), n)` (Gray et al. 2001, eq. 4.10).
+    pub artificial_stress: Option<(f64, i32)>,
 }
 
 impl AccelTerms {
@@ -129,6 +131,9 @@ impl AccelTerms {
         s.acc += solid::momentum(a, b, ab);
         if let Some((alpha, c)) = self.viscosity {
             s.acc += monaghan_values(a.u - b.u, (a.rho, b.rho), b.m, ab, alpha, c);
+        }
+        if let Some((w_dx, n)) = self.artificial_stress {
+            s.acc += solid::artificial_stress_momentum(a, b, ab, w_dx, n);
         }
         if let Some((w_dx, r, n)) = self.sun {
             s.ac += sun2019_volume(b.vol, ab, w_dx, r, n);

@@ -28,9 +28,10 @@ impl<const D: usize> SolidPasses<D> {
     fn gather(&mut self, solid: &ElasticSolid<D>) {
         let u_hat = solid.u_hat();
         let transport = solid.physics.gradient == GradientVelocity::Transport;
+        let artificial_stress = solid.physics.artificial_stress.map(|a| a.eps);
         let point = |i: usize| {
             let v_grad = if transport { u_hat[i] } else { solid.u[i] };
-            SolidPoint::new(
+            let point = SolidPoint::new(
                 solid.u[i],
                 v_grad,
                 u_hat[i] - solid.u[i],
@@ -38,7 +39,11 @@ impl<const D: usize> SolidPasses<D> {
                 solid.rho[i],
                 solid.p[i],
                 solid.s[i],
-            )
+            );
+            match artificial_stress {
+                Some(eps) => point.with_artificial_stress(eps),
+                None => point,
+            }
         };
         self.points.resize(solid.len(), point(0));
         self.points.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, p)| *p = point(i));
@@ -68,8 +73,8 @@ pub fn density_and_stress_rates<const D: usize>(
     );
 }
 
-/// The accelerations of `solid` (eq. 30 with Monaghan's artificial viscosity, eq. 28, and
-/// the body force) over its list `nl` into `rates.du`, and Sun's shifting (eq. 36, for a
+/// The accelerations of `solid` (eq. 30 with Monaghan's artificial viscosity, eq. 28,
+/// Monaghan's artificial stress if the scheme has it, and the body force) over its list `nl` into `rates.du`, and Sun's shifting (eq. 36, for a
 /// step `dt`) into `rates.a_c`, after detecting the free surface (sec. 3.4) if the scheme
 /// asks, with the shifting zero on it and tangential next to it (eq. 44). Fixed particles
 /// get zero of both.
@@ -91,6 +96,7 @@ pub fn accelerations<const D: usize>(
     let terms = AccelTerms {
         viscosity: s.artificial_viscosity.map(|alpha| (alpha, solid.material.c0())),
         sun: s.shifting.map(|sh| (sh.w_dx, sh.r, sh.n)),
+        artificial_stress: s.artificial_stress.map(|a| (a.w_dx, a.n)),
     };
     // -(Ma c0) 2h / dt, eq. (36)
     let sun_prefactor = s.shifting.map_or(0.0, |sh| -sh.ma_c0 * 2.0 * h / dt);

@@ -1,8 +1,8 @@
 //! The schemes of an elastic solid: which velocity its velocity gradient is taken of,
 //! whether the transport-velocity correction terms are evaluated, how its particles are
-//! homogenised, and its artificial viscosity. `ctvf` and `gtvf` are two values of
-//! [`SolidScheme`] built from one [`SolidSettings`] ([`SolidSchemeName::solid_scheme`]),
-//! not two code paths: they differ in two switches.
+//! homogenised, and its artificial viscosity and stress. `ctvf`, `gtvf` and `gray` are
+//! values of [`SolidScheme`] built from one [`SolidSettings`]
+//! ([`SolidSchemeName::solid_scheme`]), not separate code paths: they differ in switches.
 
 use super::Pst;
 use serde::{Deserialize, Serialize};
@@ -18,12 +18,29 @@ pub enum SolidSchemeName {
     /// GTVF (Zhang, Hu & Adams 2017): the velocity gradient of the transport velocity u~,
     /// no correction terms (CTVF sec. 4.4 and 5 compare the two).
     Gtvf,
+    /// Gray, Monaghan & Swift (2001): no transport velocity (no shifting), Monaghan's
+    /// artificial stress against the tensile instability, as PySPH's
+    /// `ElasticSolidsScheme` runs it.
+    Gray,
 }
 
 named_choices!(SolidSchemeName {
     Ctvf => "ctvf",
     Gtvf => "gtvf",
+    Gray => "gray",
 });
+
+/// Monaghan's artificial stress (Gray et al. 2001, eqs. 4.7-4.10): `eps`, the exponent `n`
+/// of `f_ab = W_ab / W(dx)`, and W(dx).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ArtificialStress {
+    /// epsilon of R = -eps sigma / rho^2 in tension (0.3 in Gray et al. 2001 and PySPH).
+    pub eps: f64,
+    /// The exponent n of f_ab (4).
+    pub n: i32,
+    /// Kernel value at the initial spacing, W(dx).
+    pub w_dx: f64,
+}
 
 /// Which velocity the velocity gradient of eq. (31) is taken of.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -62,6 +79,9 @@ pub struct SolidScheme {
     pub shifting: Option<SolidShifting>,
     /// Monaghan's artificial viscosity alpha (eq. 28), if any.
     pub artificial_viscosity: Option<f64>,
+    /// Monaghan's artificial stress (`gray`), if any.
+    #[serde(default)]
+    pub artificial_stress: Option<ArtificialStress>,
     /// Detect the free surface (sec. 3.4) and keep the shifting tangential near it (eq. 44).
     pub free_surface: bool,
     /// Body force per unit mass.
@@ -94,8 +114,15 @@ pub struct SolidSettings {
 
 impl SolidSchemeName {
     /// The composition this name stands for. IPST is refused: its pass reads a fluid's
-    /// views and is not yet given a solid's.
+    /// views and is not yet given a solid's. `gray` has no transport velocity, so it takes
+    /// `pst` = none only.
     pub fn solid_scheme(self, s: &SolidSettings) -> Result<SolidScheme, String> {
+        if self == SolidSchemeName::Gray && s.pst != Pst::None {
+            return Err(format!(
+                "`scheme` = gray has no transport velocity to shift with: `pst` = {} is refused (give `pst` = none)",
+                Pst::NAMES[s.pst as usize]
+            ));
+        }
         let shifting = match s.pst {
             Pst::Sun => Some(SolidShifting { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 }),
             Pst::None => None,
@@ -106,13 +133,17 @@ impl SolidSchemeName {
         let (gradient, corrections) = match self {
             SolidSchemeName::Ctvf => (GradientVelocity::Momentum, s.corrections),
             SolidSchemeName::Gtvf => (GradientVelocity::Transport, false),
+            SolidSchemeName::Gray => (GradientVelocity::Momentum, false),
         };
+        let artificial_stress =
+            (self == SolidSchemeName::Gray).then_some(ArtificialStress { eps: 0.3, n: 4, w_dx: s.w_dx });
         Ok(SolidScheme {
             name: self,
             gradient,
             corrections: corrections && shifting.is_some(),
             shifting,
             artificial_viscosity: (s.alpha > 0.0).then_some(s.alpha),
+            artificial_stress,
             free_surface: shifting.is_some(),
             gravity: s.gravity,
         })
@@ -141,6 +172,9 @@ impl fmt::Display for SolidScheme {
         match self.artificial_viscosity {
             Some(a) => writeln!(f, "  momentum: eq. (30), artificial viscosity alpha = {a} (eq. 28)")?,
             None => writeln!(f, "  momentum: eq. (30)")?,
+        }
+        if let Some(a) = self.artificial_stress {
+            writeln!(f, "  artificial stress: Monaghan (Gray et al. 2001), eps = {}, n = {}", a.eps, a.n)?;
         }
         match self.shifting {
             Some(s) => write!(
@@ -174,6 +208,10 @@ mod tests {
         let same = SolidScheme { name: c.name, gradient: c.gradient, corrections: c.corrections, ..g };
         assert_eq!(same, c);
         assert!(SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Ipst)).unwrap_err().contains("ipst"));
+        let gray = SolidSchemeName::Gray.solid_scheme(&settings(Pst::None)).unwrap();
+        assert!(gray.shifting.is_none() && !gray.corrections && gray.artificial_stress.is_some());
+        assert!(SolidSchemeName::Gray.solid_scheme(&settings(Pst::Sun)).unwrap_err().contains("gray"));
+        assert!(c.artificial_stress.is_none() && g.artificial_stress.is_none());
         let still = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(still.shifting.is_none() && !still.corrections, "no transport velocity: nothing to correct");
     }

@@ -4,13 +4,20 @@
 //! ([`SolidMaterial`]: E, nu, rho0, giving K, c0 and G), its time-step limit (eq. 62) and
 //! its kick-drift-kick updates (eqs. 54-60, with eq. 58 for the stress).
 //!
-//! **Clamps.** A clamped region is made of particles of the same body flagged `fixed`:
-//! they take part in every sum as neighbours and their density, pressure and deviatoric
-//! stress evolve by the same rates as the others' (a continuum held at u = 0), but their
-//! accelerations and shifting are zero, so they never move. This is the set-up of Gray et
-//! al. (2001), which the paper's oscillating plate (sec. 4.4, fig. 17) follows; it needs no
-//! extrapolation of the stress onto a separate boundary (eq. 53).
+//! **Clamps and pistons.** A clamped region is made of particles of the same body flagged
+//! `fixed`: they take part in every sum as neighbours and their density, pressure and
+//! deviatoric stress evolve by the same rates as the others' (a continuum held at its
+//! prescribed velocity), but their accelerations and shifting are zero, so they keep the
+//! velocity they were given: zero for a clamp, the piston's for a moving boundary
+//! (sec. 4.5). This is the set-up of Gray et al. (2001), which the paper's oscillating
+//! plate (sec. 4.4, fig. 17) follows; it needs no extrapolation of the stress onto a
+//! separate boundary (eq. 53).
+//!
+//! **Plasticity.** A material with a yield stress Y0 is elastic-perfectly plastic
+//! (sec. 4.7): after every stress update the deviatoric stress is returned radially onto
+//! the von Mises surface ([`radial_return`]).
 
+use crate::solver::equations::solid::radial_return;
 use crate::solver::integrator;
 use crate::solver::math::{Matrix, Vector};
 use crate::solver::scheme::SolidScheme;
@@ -26,6 +33,10 @@ pub struct SolidMaterial {
     pub poisson_ratio: f64,
     /// Reference density rho0 (kg/m^3).
     pub rho0: f64,
+    /// Yield stress Y0 (Pa) of an elastic-perfectly-plastic material (sec. 4.7); `None`:
+    /// elastic.
+    #[serde(default)]
+    pub yield_stress: Option<f64>,
 }
 
 impl SolidMaterial {
@@ -43,7 +54,25 @@ impl SolidMaterial {
         if !(rho0 > 0.0 && rho0.is_finite()) {
             return Err(format!("density {rho0} must be positive"));
         }
-        Ok(Self { youngs_modulus, poisson_ratio, rho0 })
+        Ok(Self { youngs_modulus, poisson_ratio, rho0, yield_stress: None })
+    }
+
+    /// The material made elastic-perfectly plastic with yield stress `y0`, refused unless
+    /// positive and finite.
+    pub fn with_yield_stress(self, y0: f64) -> Result<Self, String> {
+        if !(y0 > 0.0 && y0.is_finite()) {
+            return Err(format!("yield stress {y0} must be positive"));
+        }
+        Ok(Self { yield_stress: Some(y0), ..self })
+    }
+
+    /// The material of given bulk modulus `K` and shear modulus `G` (as papers that state a
+    /// sound speed and a shear modulus give it, `K = rho0 c0^2`): `E = 9 K G / (3 K + G)`,
+    /// `nu = (3 K - 2 G) / (2 (3 K + G))`.
+    pub fn from_bulk_and_shear(bulk: f64, shear: f64, rho0: f64) -> Result<Self, String> {
+        let e = 9.0 * bulk * shear / (3.0 * bulk + shear);
+        let nu = (3.0 * bulk - 2.0 * shear) / (2.0 * (3.0 * bulk + shear));
+        Self::new(e, nu, rho0)
     }
 
     /// Bulk modulus `K = E / (3 (1 - 2 nu)) = rho0 c0^2` (eq. 8 and the text below it).
@@ -79,7 +108,7 @@ pub struct SolidInit<const D: usize> {
     pub m: Vec<f64>,
     /// Densities.
     pub rho: Vec<f64>,
-    /// Held in place (a clamp).
+    /// Moved at its initial velocity whatever the forces (a clamp at rest, a piston).
     pub fixed: Vec<bool>,
 }
 
@@ -108,7 +137,8 @@ pub struct ElasticSolid<const D: usize> {
     pub p: Vec<f64>,
     /// Deviatoric stress sigma' (symmetric).
     pub s: Vec<Matrix<D>>,
-    /// Held in place (a clamp): zero acceleration and shifting.
+    /// Moved at the velocity it was given (a clamp, a piston): zero acceleration and
+    /// shifting.
     pub fixed: Vec<bool>,
 }
 
@@ -174,12 +204,7 @@ impl<const D: usize> ElasticSolid<D> {
         if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
             return Err(format!("solid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
         }
-        let mut u = init.u;
-        for (u, &fixed) in u.iter_mut().zip(&init.fixed) {
-            if fixed {
-                *u = Vector::zeros();
-            }
-        }
+        let u = init.u;
         let u_hat = physics.shifting.is_some().then(|| u.clone());
         let p = init.rho.iter().map(|&r| material.pressure(r)).collect();
         Ok(Self {
@@ -231,7 +256,8 @@ impl<const D: usize> ElasticSolid<D> {
     }
 
     /// The update of density, pressure and deviatoric stress over `dt` (eqs. 56, 8, 58)
-    /// by rates evaluated at the start of the step with the half-step velocities (sec. 3.7).
+    /// by rates evaluated at the start of the step with the half-step velocities (sec. 3.7),
+    /// the stress returned onto the yield surface if the material is plastic (sec. 4.7).
     pub fn update_state(&mut self, r: &SolidRates<D>, dt: f64) {
         let material = self.material;
         for ((rho, p), drho) in self.rho.iter_mut().zip(&mut self.p).zip(&r.drho) {
@@ -240,6 +266,9 @@ impl<const D: usize> ElasticSolid<D> {
         }
         for (s, ds) in self.s.iter_mut().zip(&r.ds) {
             *s += ds * dt;
+            if let Some(y0) = material.yield_stress {
+                *s = radial_return(s, y0);
+            }
         }
     }
 
@@ -288,7 +317,7 @@ mod tests {
     }
 
     #[test]
-    fn fixed_particles_start_at_rest_and_fields_follow_the_scheme() {
+    fn fixed_particles_keep_their_velocity_and_fields_follow_the_scheme() {
         let init = SolidInit {
             x: vec![Vector::<2>::zeros(), Vector::<2>::new(1.0, 0.0)],
             u: vec![Vector::<2>::new(1.0, 0.0); 2],
@@ -299,8 +328,7 @@ mod tests {
         let s =
             ElasticSolid::new("plate", 0.1, init, SolidMaterial::new(1.0, 0.3, 1000.0).unwrap(), physics())
                 .unwrap();
-        assert_eq!(s.u[0], Vector::<2>::zeros());
-        assert_eq!(s.u[1], Vector::<2>::new(1.0, 0.0));
+        assert_eq!(s.u, vec![Vector::<2>::new(1.0, 0.0); 2]);
         assert_eq!(s.u_hat.as_ref().unwrap().len(), 2);
         let bad = SolidInit { fixed: vec![false], ..SolidInit::<2>::default() };
         assert!(ElasticSolid::new("plate", 0.1, bad, s.material, physics())

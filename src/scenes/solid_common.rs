@@ -1,0 +1,199 @@
+//! What the elastic-solid scenes share: the material and scheme parameters every one of
+//! them takes (`dx`, `hdx`, `youngs_modulus`, `poisson_ratio`, `density`, `yield_stress`
+//! where plastic, `alpha`, `scheme`, `pst`, `corrections`), their checks by key before any
+//! particle is made, and the [`SolidSetup`] they give; plus the step-by-step advance a
+//! solid scene uses to follow its probes at every step ([`forward_stepwise`]).
+
+use super::params::{Bound, Params, Spec};
+use crate::solver::kernel::{Kernel, KernelKind};
+use crate::solver::scheme::{Pst, SolidScheme, SolidSchemeName, SolidSettings};
+use crate::solver::systems::SolidMaterial;
+
+/// The most steps a run may need (as the fluid scenes' bound).
+pub const MAX_STEPS: f64 = 1e9;
+
+/// A solid scene's defaults: the paper's case.
+#[derive(Clone, Copy, Debug)]
+pub struct SolidDefaults {
+    /// Particle spacing (m).
+    pub dx: f64,
+    /// Young's modulus (Pa).
+    pub youngs_modulus: f64,
+    /// Poisson's ratio.
+    pub poisson_ratio: f64,
+    /// Reference density (kg/m^3).
+    pub density: f64,
+    /// The yield stress Y0 (Pa) of an elastic-perfectly-plastic material; `None`: elastic,
+    /// and the scene has no `yield_stress` parameter.
+    pub yield_stress: Option<f64>,
+    /// Artificial viscosity alpha of eq. (28).
+    pub alpha: f64,
+    /// The default shifting.
+    pub pst: &'static str,
+}
+
+/// The shifting choices of a solid.
+pub const SOLID_PST: &[&str] = &["sun", "ipst", "none"];
+
+/// The parameters of a solid scene with defaults `d` (the scene's own come before them and
+/// the common ones after).
+pub fn solid_params(d: &SolidDefaults) -> Vec<Spec> {
+    let mut v = vec![
+        Spec::float("dx", d.dx, Bound::Positive, "particle spacing (m)"),
+        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
+        Spec::float("youngs_modulus", d.youngs_modulus, Bound::Positive, "Young's modulus E (Pa)"),
+        Spec::float("poisson_ratio", d.poisson_ratio, Bound::None, "Poisson's ratio nu, in (-1, 0.5)"),
+        Spec::float("density", d.density, Bound::Positive, "reference density rho0 (kg/m^3)"),
+    ];
+    if let Some(y0) = d.yield_stress {
+        v.push(Spec::float(
+            "yield_stress",
+            y0,
+            Bound::Positive,
+            "yield stress Y0 (Pa) of the elastic-perfectly-plastic material (sec. 4.7)",
+        ));
+    }
+    v.extend([
+        Spec::float("alpha", d.alpha, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
+        Spec::choice(
+            "scheme",
+            SolidSchemeName::NAMES,
+            "ctvf",
+            "solid scheme: ctvf (eq. 31 of u, corrections), gtvf (of u~, none) or gray (no transport velocity, Monaghan's artificial stress)",
+        ),
+        Spec::choice(
+            "pst",
+            SOLID_PST,
+            d.pst,
+            "particle shifting: Sun 2019 (eq. 36), IPST (sec. 3.3) or none (gray: none)",
+        ),
+        Spec::choice(
+            "corrections",
+            &["all", "none"],
+            "all",
+            "the CTVF correction terms of eqs. (25) and (32) (ctvf)",
+        ),
+    ]);
+    v
+}
+
+/// What a solid scene's parameters make, once every check that needs no particle passed.
+#[derive(Clone, Debug)]
+pub struct SolidSetup {
+    /// The material.
+    pub material: SolidMaterial,
+    /// The solid's scheme.
+    pub scheme: SolidScheme,
+    /// The kernel (quintic spline, as the paper's solids).
+    pub kernel: Kernel,
+    /// Particle spacing.
+    pub dx: f64,
+    /// Smoothing length `hdx dx`.
+    pub h: f64,
+}
+
+impl SolidSetup {
+    /// Kernel support layers of spacing `dx`: how deep a clamp must be.
+    pub fn support_layers(&self) -> usize {
+        (self.kernel.support() * self.h / self.dx).ceil() as usize
+    }
+}
+
+/// The setup of scene `scene` from `p`: the material (refused by key: `poisson_ratio`
+/// outside (-1, 0.5), `hdx` outside [0.5, 3]), the scheme, and a check that `tf` needs no
+/// more than [`MAX_STEPS`] steps of eq. (62) at the largest speed `u_max` the scene
+/// expects. `u_ref` is the reference speed of Sun's shifting (eq. 36).
+pub fn solid_setup(
+    scene: &str,
+    p: &Params,
+    u_max: f64,
+    u_ref: f64,
+    gravity: [f64; 3],
+) -> Result<SolidSetup, String> {
+    let bad =
+        |key: &str, why: &str| Err(format!("scene `{scene}`: parameter `{key}` = {:?}: {why}", p.float(key)));
+    let nu = p.float("poisson_ratio");
+    if !(nu > -1.0 && nu < 0.5) {
+        return bad(
+            "poisson_ratio",
+            "must lie in (-1, 0.5): at 0.5 the bulk modulus is infinite, at -1 the shear modulus",
+        );
+    }
+    let hdx = p.float("hdx");
+    if !(0.5..=3.0).contains(&hdx) {
+        return bad("hdx", "must lie in [0.5, 3]: the kernel must reach the nearest particles");
+    }
+    let mut material = SolidMaterial::new(p.float("youngs_modulus"), nu, p.float("density"))
+        .map_err(|e| format!("scene `{scene}`: {e}"))?;
+    if p.0.contains_key("yield_stress") {
+        material = material
+            .with_yield_stress(p.float("yield_stress"))
+            .map_err(|e| format!("scene `{scene}`: {e}"))?;
+    }
+    let dx = p.float("dx");
+    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    let h = hdx * dx;
+    // Eq. (62) at the largest expected speed: a run of more steps than any machine takes
+    // is refused.
+    let dt = p.float("cfl") * h / (material.c0() + u_max);
+    let steps = p.float("tf") / dt;
+    if steps.is_nan() || steps > MAX_STEPS {
+        return Err(format!(
+            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, h = `hdx` `dx`: more than {MAX_STEPS:e}",
+            p.float("tf"),
+            material.c0()
+        ));
+    }
+    let pst = Pst::from_name(p.str("pst")).expect("checked choice");
+    let name = SolidSchemeName::from_name(p.str("scheme")).expect("checked choice");
+    let settings = SolidSettings {
+        pst,
+        corrections: p.str("corrections") == "all",
+        alpha: p.float("alpha"),
+        u_ref,
+        w_dx: kernel.w(dx, h),
+        gravity,
+    };
+    let scheme = name.solid_scheme(&settings).map_err(|e| format!("scene `{scene}`: {e}"))?;
+    Ok(SolidSetup { material, scheme, kernel, dx, h })
+}
+
+/// A particle count in floating point first, refused beyond 5e6 particles (a spacing of
+/// 1e-300 m must not overflow a count).
+pub fn check_count(scene: &str, what: &str, count: f64) -> Result<(), String> {
+    if !(count <= 5e6) {
+        return Err(format!("scene `{scene}`: {what} makes {count:.3e} particles: more than 5e6"));
+    }
+    Ok(())
+}
+
+/// The [`SceneRun`](super::SceneRun) methods of a scene whose state is `self.sim`, with an
+/// advance that steps one step at a time and calls `self.after_step()` after each (to
+/// follow probes, crossings or extrema at every step).
+macro_rules! forward_stepwise {
+    () => {
+        $crate::scenes::common::forward_counts!();
+        fn advance(
+            &mut self,
+            t_stop: f64,
+            t_end: f64,
+            on_step: &mut dyn FnMut(f64, u64) -> bool,
+        ) -> Result<bool, $crate::solver::simulation::Divergence> {
+            let eps = 1e-12 * t_end.abs().max(1.0);
+            loop {
+                let now = self.sim.time();
+                if now >= t_stop - eps || t_end - now <= eps {
+                    return Ok(true);
+                }
+                // As `Simulation::advance` does: only the step that would pass t_end is
+                // shortened.
+                self.sim.step(t_end - now)?;
+                self.after_step();
+                if !on_step(self.sim.time(), self.sim.steps()) {
+                    return Ok(false);
+                }
+            }
+        }
+    };
+}
+pub(crate) use forward_stepwise;
