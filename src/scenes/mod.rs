@@ -15,6 +15,7 @@ pub mod params;
 pub mod progress;
 pub mod solid_common;
 pub mod tank;
+pub mod uniaxial_compression;
 pub mod taylor_green;
 
 use crate::solver::simulation::Divergence;
@@ -97,6 +98,7 @@ pub const SCENES: &[SceneEntry] = &[
     hydrostatic_tank::ENTRY,
     free_surface_demo::ENTRY,
     oscillating_plate::ENTRY,
+    uniaxial_compression::ENTRY,
 ];
 
 /// Looks a scene up by name.

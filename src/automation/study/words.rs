@@ -17,6 +17,8 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("scheme", "edac") => "EDAC".into(),
         ("scheme", "tvf") => "TVF".into(),
         ("scheme", "ctvf") => "CTVF".into(),
+        ("scheme", "gtvf") => "GTVF".into(),
+        ("scheme", "gray") => "Gray et al. (artificial stress)".into(),
         ("pst", "sun") => "SPST".into(),
         ("pst", "ipst") => "IPST".into(),
         ("pst", "none") => "no shifting".into(),
@@ -57,6 +59,9 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("ipst_interval", _) => format!("IPST every {} steps", num()),
         ("ipst_tol", _) => format!("tolerance {}", num()),
         ("tf", _) => format!("to t = {} s", num()),
+        ("piston_speed", _) => format!("piston at {} m/s", num()),
+        ("vf", _) => format!("V_f = {}", num()),
+        ("poisson_ratio", _) => format!("nu = {}", num()),
         ("nz", _) => format!("{} layers deep", num()),
         _ => format!("{key} = {v}"),
     }

@@ -159,6 +159,18 @@ pub fn von_mises<const D: usize>(s: &Matrix<D>) -> f64 {
     (3.0 * j2(s)).sqrt()
 }
 
+/// The von Mises stress of a 2D total stress `sigma` from its principal stresses
+/// (eqs. 68-70): `sqrt(s1^2 + s2^2 - s1 s2)`, `s1,2 = (sxx + syy)/2 +- sqrt(((sxx - syy)/2)^2
+/// + sxy^2)`. Eqs. (69)-(70) print `((sxx + syy)/2)^2` under the root, which is not the
+/// principal stresses' formula (Mohr's circle has radius `(sxx - syy)/2`); the two agree
+/// when one of sxx, syy is zero and sxy is, as at the centre of a uniaxial specimen.
+pub fn von_mises_principal(sigma: &Matrix<2>) -> f64 {
+    let mean = 0.5 * (sigma[(0, 0)] + sigma[(1, 1)]);
+    let radius = (0.25 * (sigma[(0, 0)] - sigma[(1, 1)]).powi(2) + sigma[(0, 1)].powi(2)).sqrt();
+    let (s1, s2) = (mean + radius, mean - radius);
+    (s1 * s1 + s2 * s2 - s1 * s2).max(0.0).sqrt()
+}
+
 /// Monaghan's artificial stress (Monaghan 2000; Gray, Monaghan & Swift 2001, eqs. 4.7-4.9)
 /// divided by rho^2: in the principal frame of the total stress `sigma = -p I + sigma'`,
 /// `R_ii = -eps sigma_ii / rho^2` where `sigma_ii > 0` (tension) and 0 where not, rotated
@@ -214,6 +226,17 @@ mod tests {
         assert!((von_mises(&r) - y0).abs() < 1e-9 * y0, "{}", von_mises(&r));
         let ratio = r.component_div(&beyond);
         assert!(ratio.iter().all(|&f| (f - ratio[0]).abs() < 1e-12), "direction kept");
+    }
+
+    /// Eqs. (68)-(70) by hand: a uniaxial stress of -3 has von Mises stress 3; a pure shear
+    /// of 2 has principal stresses +-2, so sqrt(4 + 4 + 4) = 2 sqrt(3); a hydrostatic
+    /// stress has none.
+    #[test]
+    fn von_mises_from_principal_stresses() {
+        assert!((von_mises_principal(&Matrix::<2>::new(0.0, 0.0, 0.0, -3.0)) - 3.0).abs() < 1e-15);
+        let shear = Matrix::<2>::new(0.0, 2.0, 2.0, 0.0);
+        assert!((von_mises_principal(&shear) - 2.0 * 3f64.sqrt()).abs() < 1e-14);
+        assert!(von_mises_principal(&(Matrix::<2>::identity() * 5.0)).abs() < 1e-12);
     }
 
     /// Artificial stress by hand: a uniaxial tension sigma_xx = 4 (p = 0, rho = 2) gives
