@@ -18,7 +18,7 @@
 
 use super::cache::{self, Entry};
 use super::registry::{FigureKind, Problem};
-use super::study::snapshot::{pick_snapshot, pvd_entries, pvd_text};
+use super::study::snapshot::{drawn_series, pick_snapshot, pvd_entries, pvd_text};
 use crate::solver::output::summary::{Status, Summary};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
@@ -130,7 +130,10 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
         }
         // The snapshots the particle figures draw: of the first selected case with a result,
         // the one nearest the figure's time, and the walls' nearest it.
-        let mut snaps: BTreeMap<PathBuf, (PathBuf, BTreeSet<String>, BTreeSet<String>)> = BTreeMap::new();
+        // Per case folder: where it is exported, the series drawn, its files and the walls'.
+        #[allow(clippy::type_complexity)]
+        let mut snaps: BTreeMap<PathBuf, (PathBuf, String, BTreeSet<String>, BTreeSet<String>)> =
+            BTreeMap::new();
         for f in &p.figures {
             let FigureKind::Particles { time, .. } = &f.kind else { continue };
             let drawn = f
@@ -140,18 +143,20 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
                 .map(|c| Entry::new(output, p, c))
                 .find(|e| finished(&dest(e)) || finished(&e.dir));
             let Some(e) = drawn.filter(|e| finished(&e.dir)) else { continue };
-            let list = pvd_entries(&e.dir, "fluid.pvd")?;
+            let series = drawn_series(&e.dir)?;
+            let list = pvd_entries(&e.dir, &series)?;
             let (t, file) = pick_snapshot(&list, *time).clone();
-            let slot =
-                snaps.entry(e.dir.clone()).or_insert_with(|| (dest(&e), BTreeSet::new(), BTreeSet::new()));
-            slot.1.insert(file);
+            let slot = snaps
+                .entry(e.dir.clone())
+                .or_insert_with(|| (dest(&e), series, BTreeSet::new(), BTreeSet::new()));
+            slot.2.insert(file);
             if e.dir.join("wall.pvd").exists() {
                 let walls = pvd_entries(&e.dir, "wall.pvd")?;
-                slot.2.insert(pick_snapshot(&walls, Some(t)).1.clone());
+                slot.3.insert(pick_snapshot(&walls, Some(t)).1.clone());
             }
         }
-        for (from, (to, fluid, wall)) in snaps {
-            for (series, files) in [("fluid.pvd", &fluid), ("wall.pvd", &wall)] {
+        for (from, (to, drawn, fluid, wall)) in snaps {
+            for (series, files) in [(drawn.as_str(), &fluid), ("wall.pvd", &wall)] {
                 if files.is_empty() {
                     continue;
                 }

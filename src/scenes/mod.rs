@@ -9,14 +9,15 @@ pub mod dam_break;
 pub mod free_surface_demo;
 pub mod geometry;
 pub mod harness;
+pub mod high_velocity_impact;
 pub mod hydrostatic_tank;
 pub mod oscillating_plate;
 pub mod params;
 pub mod progress;
 pub mod solid_common;
 pub mod tank;
-pub mod uniaxial_compression;
 pub mod taylor_green;
+pub mod uniaxial_compression;
 
 use crate::solver::simulation::Divergence;
 use params::{Params, Spec};
@@ -99,6 +100,7 @@ pub const SCENES: &[SceneEntry] = &[
     free_surface_demo::ENTRY,
     oscillating_plate::ENTRY,
     uniaxial_compression::ENTRY,
+    high_velocity_impact::ENTRY,
 ];
 
 /// Looks a scene up by name.

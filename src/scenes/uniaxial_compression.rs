@@ -37,7 +37,9 @@
 
 use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup};
+use super::solid_common::{
+    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
+};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::equations::solid::von_mises_principal;
 use crate::solver::math::{Matrix, Vector};
@@ -67,7 +69,12 @@ fn params() -> Vec<Spec> {
     let mut v = vec![
         Spec::float("width", 0.082, Bound::Positive, "specimen width W (m)"),
         Spec::float("height", 0.14, Bound::Positive, "specimen height H (m)"),
-        Spec::float("piston_speed", 1.5e-3, Bound::Positive, "the piston's speed (m/s); the paper's is 1.5 mm/s"),
+        Spec::float(
+            "piston_speed",
+            1.5e-3,
+            Bound::Positive,
+            "the piston's speed (m/s); the paper's is 1.5 mm/s",
+        ),
     ];
     v.extend(solid_params(&SolidDefaults {
         dx: 0.001,

@@ -441,11 +441,12 @@ fn prepare(
                 f => format!(" `{f}` from {} to {}.", fmt_value(lo), fmt_value(hi)),
             };
             let ours = format!(
-                "Drawn: {who}, at t = {t:.3} s{asked}.{range} {}",
+                "Drawn: {who}, at t = {} s{asked}.{range} {}",
+                time_text(t, 3),
                 numbers(f, std::slice::from_ref(r))
             );
             let fig = report::ScatterField {
-                title: format!("{} (t = {t:.2} s)", f.title),
+                title: format!("{} (t = {} s)", f.title, time_text(t, 2)),
                 x: s.x,
                 y: s.y,
                 value: s.value,
@@ -564,6 +565,17 @@ fn metrics_table(p: &Problem, t: &Table, output: &Path, tables: &Path) -> Result
         md_path: format!("tables/{}.md", t.id),
         caption: if t.info.caption.is_empty() { t.title.clone() } else { t.info.caption.clone() },
     })
+}
+
+/// A snapshot's time in seconds for titles and text: `decimals` decimals, or three
+/// significant digits in scientific notation for times below 0.01 s (an impact's
+/// microseconds).
+fn time_text(t: f64, decimals: usize) -> String {
+    if t != 0.0 && t.abs() < 0.01 {
+        format!("{t:.2e}")
+    } else {
+        format!("{t:.decimals$}")
+    }
 }
 
 #[cfg(test)]

@@ -25,6 +25,23 @@ pub(crate) fn pvd_entries(dir: &Path, name: &str) -> Result<Vec<(f64, String)>, 
     Ok(list)
 }
 
+/// The series a particle figure draws in case folder `dir`: `fluid.pvd` when the case has a
+/// fluid, else the first other body's series by name (a solid's, e.g. `plate.pvd`), never
+/// the walls'. Errors when the folder has no series.
+pub(crate) fn drawn_series(dir: &Path) -> Result<String, String> {
+    if dir.join("fluid.pvd").exists() {
+        return Ok("fluid.pvd".into());
+    }
+    let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut names: Vec<String> = rd
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".pvd") && n != "wall.pvd")
+        .collect();
+    names.sort();
+    names.into_iter().next().ok_or_else(|| format!("{}: no snapshot series (*.pvd)", dir.display()))
+}
+
 /// The entry nearest `time` (the first of equally near ones), or the last one.
 pub(crate) fn pick_snapshot(list: &[(f64, String)], time: Option<f64>) -> &(f64, String) {
     match time {
@@ -168,7 +185,7 @@ pub(crate) struct Snapshot {
     pub t: f64,
 }
 
-/// The snapshot listed in `fluid.pvd` of `dir` nearest `time` (the last one without a
+/// The snapshot listed in the [`drawn_series`] of `dir` nearest `time` (the last one without a
 /// time): points, field `field`, the x, y components of the vector array `arrows`, and the
 /// wall particles of the `wall.pvd` snapshot nearest it. `None` when the file the series
 /// lists is not there (a committed result keeps only the snapshots its figures draw).
@@ -178,7 +195,7 @@ pub(crate) fn snapshot(
     time: Option<f64>,
     arrows: Option<&str>,
 ) -> Result<Option<Snapshot>, String> {
-    let list = pvd_entries(dir, "fluid.pvd")?;
+    let list = pvd_entries(dir, &drawn_series(dir)?)?;
     let (t, file) = pick_snapshot(&list, time).clone();
     let Some((path, xml)) = read_vtu(dir, &file)? else {
         return Ok(None);
