@@ -100,7 +100,7 @@ fn params() -> Vec<Spec> {
             "separation",
             0.082,
             Bound::Positive,
-            "distance between the rings' centres (m); at least 2 r_max + dx",
+            "distance between the rings' centres (m); more than 2 r_max",
         ),
     ];
     v.extend(solid_params(&SolidDefaults {
@@ -145,10 +145,10 @@ fn setup(p: &Params) -> Result<Setup, String> {
     let v0 = p.float("v0_over_c0") * c0;
     let solid = solid_setup(scene, p, v0, v0, [0.0; 3])?;
     let dx = solid.dx;
-    if sep < 2.0 * ro + dx {
+    if sep <= 2.0 * ro {
         return Err(format!(
-            "scene `{scene}`: parameter `separation` = {sep:?}: the rings overlap; it must be at least 2 `outer_radius` + `dx` = {:?}",
-            2.0 * ro + dx
+            "scene `{scene}`: parameter `separation` = {sep:?}: the rings overlap; it must exceed 2 `outer_radius` = {:?}",
+            2.0 * ro
         ));
     }
     let circles = ((ro - ri) / dx).round();
@@ -368,7 +368,11 @@ mod tests {
             let r = (p - Vector::<2>::new(-0.041, 0.0)).norm();
             assert!(r > ri && r < 0.04, "{r}");
         }
-        assert!((x[top][0] + 0.041).abs() < 0.5 * dx && (x[top][1] - 0.0395).abs() < 1e-3 * dx, "{:?}", x[top]);
+        assert!(
+            (x[top][0] + 0.041).abs() < 0.5 * dx && (x[top][1] - 0.0395).abs() < 1e-3 * dx,
+            "{:?}",
+            x[top]
+        );
     }
 
     /// The quick resolution (dx = 0.002) with the rings' outer surfaces 1 cm apart

@@ -194,7 +194,12 @@ impl Extrema {
             return None;
         }
         let ((t1, y1), (t2, y2)) = (self.troughs[k - 2], self.troughs[k - 1]);
-        let peak = self.peaks.iter().filter(|(t, _)| *t > t1 && *t < t2).map(|p| p.1).fold(f64::NEG_INFINITY, f64::max);
+        let peak = self
+            .peaks
+            .iter()
+            .filter(|(t, _)| *t > t1 && *t < t2)
+            .map(|p| p.1)
+            .fold(f64::NEG_INFINITY, f64::max);
         let low = y1.min(y2);
         Some((0.5 * (peak + low), 0.5 * (peak - low), 1.0 / (t2 - t1)))
     }
@@ -251,7 +256,8 @@ fn flag(p: &Params) -> Result<Flag, String> {
         && close(material.poisson_ratio, bnu)
         && close(material.rho0, brho)
         && close(p.float("gravity"), bg);
-    let mut run = Flag { sim, tip, a0: Vector::<2>::zeros(), extrema: Extrema::new(HYSTERESIS * hf), benchmark };
+    let mut run =
+        Flag { sim, tip, a0: Vector::<2>::zeros(), extrema: Extrema::new(HYSTERESIS * hf), benchmark };
     run.a0 = run.point_a();
     Ok(run)
 }
@@ -278,7 +284,10 @@ impl SceneRun for Flag {
     fn plan(&self) -> String {
         plan(
             &self.sim,
-            &format!("clamp of {} fixed particles in the cylinder", self.solid().fixed.iter().filter(|&&f| f).count()),
+            &format!(
+                "clamp of {} fixed particles in the cylinder",
+                self.solid().fixed.iter().filter(|&&f| f).count()
+            ),
         )
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
@@ -307,7 +316,8 @@ impl SceneRun for Flag {
         serde_json::json!({ "sim": &self.sim.state, "extrema": &self.extrema })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.extrema = serde_json::from_value(state["extrema"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.extrema =
+            serde_json::from_value(state["extrema"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
         restore_sim(&mut self.sim, &state)
     }
 }
