@@ -4,6 +4,7 @@
 //! [`SCENES`].
 
 pub mod cavity;
+pub mod colliding_rings;
 pub mod common;
 pub mod dam_break;
 pub mod free_surface_demo;
@@ -17,6 +18,7 @@ pub mod progress;
 pub mod solid_common;
 pub mod tank;
 pub mod taylor_green;
+pub mod turek_csm3;
 pub mod uniaxial_compression;
 
 use crate::solver::simulation::Divergence;
@@ -100,7 +102,9 @@ pub const SCENES: &[SceneEntry] = &[
     free_surface_demo::ENTRY,
     oscillating_plate::ENTRY,
     uniaxial_compression::ENTRY,
+    colliding_rings::ENTRY,
     high_velocity_impact::ENTRY,
+    turek_csm3::ENTRY,
 ];
 
 /// Looks a scene up by name.
@@ -180,6 +184,9 @@ mod tests {
             ("free_surface_demo", &["dx=0.2"]),
             ("oscillating_plate", &["poisson_ratio=0.5"]),
             ("oscillating_plate", &["dx=0.05"]),
+            ("colliding_rings", &["separation=0.05"]),
+            ("colliding_rings", &["dx=0.02"]),
+            ("turek_csm3", &["dx=0.02"]),
         ];
         for (scene, sets) in cases {
             let e = find(scene).unwrap();
@@ -203,6 +210,8 @@ mod tests {
                 "taylor_green" | "taylor_green_3d" | "cavity" => vec!["nx=16"],
                 "dam_break" => vec!["dx=0.1"],
                 "oscillating_plate" => vec!["dx=0.01"],
+                "colliding_rings" => vec!["dx=0.004"],
+                "turek_csm3" => vec!["dx=0.005"],
                 _ => vec![],
             };
             for pst in ["sun", "none"] {

@@ -161,7 +161,7 @@ pub fn solid_setup(
 /// A particle count in floating point first, refused beyond 5e6 particles (a spacing of
 /// 1e-300 m must not overflow a count).
 pub fn check_count(scene: &str, what: &str, count: f64) -> Result<(), String> {
-    if !(count <= 5e6) {
+    if count.is_nan() || count > 5e6 {
         return Err(format!("scene `{scene}`: {what} makes {count:.3e} particles: more than 5e6"));
     }
     Ok(())
