@@ -33,7 +33,7 @@ use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Domain};
 use crate::solver::passes::free_surface::SurfaceFields;
-use crate::solver::passes::ipst::{ipst_chi_reference, Ipst, Shifted};
+use crate::solver::passes::ipst::{ipst_chi_reference, Ipst, Shifted, Volumes};
 use crate::solver::passes::solid::SolidPasses;
 use crate::solver::passes::{accelerations, density, rates, solid, FluidPasses, Particles};
 use crate::solver::schedule::wavefront::applies as wavefront_applies;
@@ -415,8 +415,22 @@ impl<const D: usize> Simulation<D> {
         if self.fluid.is_some() {
             self.start_fluid();
         }
+        self.start_solids();
         let dt = self.nominal_dt();
-        self.solid_accelerations(dt);
+        self.solid_accelerations(dt, 0);
+    }
+
+    /// The solids' part of [`start`](Self::start): IPST's reference chi of each solid that
+    /// shifts with it, the largest on its initial configuration (a solid always has a free
+    /// surface, sec. 3.4).
+    fn start_solids(&mut self) {
+        for (c, _) in &self.couplings.solids {
+            let Body::ElasticSolid(solid) = &mut self.state.bodies[c.body] else { unreachable!("a solid") };
+            if let Some(Shifting::Ipst { chi_ref, .. }) = solid.physics.ipst.as_mut() {
+                *chi_ref =
+                    ipst_chi_reference((&solid.x, solid.h), &c.list, Boundaries::none(), &self.kernel, true);
+            }
+        }
     }
 
     /// The fluid's part of [`start`](Self::start).
@@ -770,7 +784,7 @@ impl<const D: usize> Simulation<D> {
         let body = Shifted {
             x: &fluid.x,
             // The views pass B gathered at these positions: IPST reads their volumes.
-            points: &self.work.passes.points,
+            vol: Volumes::Points(&self.work.passes.points),
             h: fluid.h,
             nl: &self.couplings.fluid_fluid.list,
             cells: &self.bins[f],
@@ -847,7 +861,7 @@ impl<const D: usize> Simulation<D> {
         if self.fluid.is_some() {
             self.homogenise(dt_nominal, self.state.steps + 1);
         }
-        self.solid_accelerations(dt_nominal);
+        self.solid_accelerations(dt_nominal, self.state.steps + 1);
         let clock = std::time::Instant::now();
         for (body, rates) in self.state.bodies.iter_mut().zip(&self.state.rates) {
             body.kick_close(rates, dt);
@@ -978,13 +992,15 @@ impl<const D: usize> Simulation<D> {
         }
     }
 
-    /// The accelerations (eq. 30) and shifting (eq. 36, for a step `dt`) of every solid.
-    fn solid_accelerations(&mut self, dt: f64) {
+    /// The accelerations (eq. 30) and shifting (eq. 36 or IPST's eqs. 37-41, for a step
+    /// `dt` and step number `next_step`) of every solid.
+    fn solid_accelerations(&mut self, dt: f64, next_step: u64) {
         let st = &mut self.state;
         for (c, passes) in &mut self.couplings.solids {
             let solid = st.bodies[c.body].as_solid().expect("a solid");
             let rates = st.rates[c.body].as_solid_mut().expect("a solid's rates");
             solid::accelerations(passes, solid, &c.list, rates, dt);
+            solid::homogenise(passes, solid, &c.list, &self.bins[c.body], &self.kernel, rates, dt, next_step);
         }
     }
 

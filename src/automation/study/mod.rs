@@ -170,6 +170,7 @@ fn missing_note(rs: &[Run]) -> String {
 fn with_unit(field: &str) -> String {
     match field {
         "pressure" => "p (Pa)".into(),
+        "von_mises" => "von Mises stress sqrt(3 J2) (Pa)".into(),
         "pressure_deviation" => "p - mean p (Pa)".into(),
         "pressure_exact" => "exact p (Pa)".into(),
         "speed" => "|u| (m/s)".into(),

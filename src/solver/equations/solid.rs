@@ -229,14 +229,14 @@ mod tests {
     }
 
     /// Eqs. (68)-(70) by hand: a uniaxial stress of -3 has von Mises stress 3; a pure shear
-    /// of 2 has principal stresses +-2, so sqrt(4 + 4 + 4) = 2 sqrt(3); a hydrostatic
-    /// stress has none.
+    /// of 2 has principal stresses +-2, so sqrt(4 + 4 + 4) = 2 sqrt(3); an equal biaxial
+    /// stress of 5 has sqrt(25 + 25 - 25) = 5 (eq. 68 is the plane-stress form).
     #[test]
     fn von_mises_from_principal_stresses() {
         assert!((von_mises_principal(&Matrix::<2>::new(0.0, 0.0, 0.0, -3.0)) - 3.0).abs() < 1e-15);
         let shear = Matrix::<2>::new(0.0, 2.0, 2.0, 0.0);
         assert!((von_mises_principal(&shear) - 2.0 * 3f64.sqrt()).abs() < 1e-14);
-        assert!(von_mises_principal(&(Matrix::<2>::identity() * 5.0)).abs() < 1e-12);
+        assert!((von_mises_principal(&(Matrix::<2>::identity() * 5.0)) - 5.0).abs() < 1e-12);
     }
 
     /// Artificial stress by hand: a uniaxial tension sigma_xx = 4 (p = 0, rho = 2) gives

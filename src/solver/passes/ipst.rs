@@ -47,15 +47,34 @@ pub struct Ipst<const D: usize> {
     witness: Mutex<Witness>,
 }
 
+/// Where IPST reads the volumes of the body it moves.
+#[derive(Clone, Copy)]
+pub enum Volumes<'a, const D: usize> {
+    /// A fluid's views as its passes last gathered them.
+    Points(&'a [Point<D>]),
+    /// Masses and densities (an elastic solid's).
+    MassDensity(&'a [f64], &'a [f64]),
+}
+
+impl<const D: usize> Volumes<'_, D> {
+    /// Particle `i`'s volume m / rho.
+    #[inline(always)]
+    fn at(&self, i: usize) -> f64 {
+        match self {
+            Volumes::Points(p) => p[i].v(),
+            Volumes::MassDensity(m, rho) => m[i] / rho[i],
+        }
+    }
+}
+
 /// What IPST moves: a body's positions `x` (binned by `cells` in their current order, listed
-/// in `nl`, smoothing length `h`), its particles' views `points` (whose volumes it reads),
-/// and its boundaries.
+/// in `nl`, smoothing length `h`), its particles' volumes, and its boundaries.
 #[derive(Clone, Copy)]
 pub struct Shifted<'a, const D: usize> {
     /// Positions.
     pub x: &'a [Vector<D>],
-    /// The particles' views as the passes last gathered them.
-    pub points: &'a [Point<D>],
+    /// The particles' volumes.
+    pub vol: Volumes<'a, D>,
     /// Smoothing length.
     pub h: f64,
     /// The body's neighbour list.
@@ -103,7 +122,7 @@ impl<const D: usize> Ipst<D> {
             a_c.par_iter_mut().with_min_len(MIN_LEN).for_each(|ac| *ac = Vector::zeros());
             return 0;
         }
-        let Shifted { x: body_x, points, h, nl, cells, boundaries } = body;
+        let Shifted { x: body_x, vol: volumes, h, nl, cells, boundaries } = body;
         let k = k.scaled(h);
         let n = body_x.len();
         let [x0, x1] = &mut w.x;
@@ -114,7 +133,7 @@ impl<const D: usize> Ipst<D> {
         // The volumes at these positions, as compact arrays (the sweeps read nothing else
         // of the neighbours).
         w.vol.resize(n, 0.0);
-        w.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = points[i].v());
+        w.vol.par_iter_mut().enumerate().with_min_len(LIGHT_LOOP_LEN).for_each(|(i, v)| *v = volumes.at(i));
         w.boundary_vol.resize_with(boundaries.iter().count(), Vec::new);
         for (vol, b) in w.boundary_vol.iter_mut().zip(boundaries.iter()) {
             vol.clear();
@@ -741,7 +760,7 @@ mod tests {
             accelerations::accelerations(&mut passes, &fluid, nl, Boundaries::none(), None, &mut rates, dt);
             let body = Shifted {
                 x: &fluid.x,
-                points: &passes.points,
+                vol: Volumes::Points(&passes.points),
                 h: fluid.h,
                 nl,
                 cells,

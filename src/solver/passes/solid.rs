@@ -4,23 +4,28 @@
 //! the body's own neighbour list, each particle writing its own row.
 
 use super::free_surface::SurfaceFields;
+use super::ipst::{Ipst, Shifted, Volumes};
 use super::{Particles, MIN_LEN};
 use crate::solver::equations::free_surface::adjust_shift;
 use crate::solver::equations::solid::SolidPoint;
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::lists::KernelList;
 use crate::solver::interactions::solid_solid::{AccelSums, AccelTerms, RateSums, RateTerms};
+use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
+use crate::solver::nnps::CellList;
 use crate::solver::scheme::{GradientVelocity, SurfaceCone};
 use crate::solver::systems::{ElasticSolid, SolidRates};
 use rayon::prelude::*;
 
-/// What a solid's passes keep between steps: the gathered views and its free surface.
+/// What a solid's passes keep between steps: the gathered views, its free surface and
+/// IPST's work space.
 #[derive(Debug, Default)]
 pub struct SolidPasses<const D: usize> {
     points: Vec<SolidPoint<D>>,
     /// The free surface, when the scheme detects one.
     pub surface: Option<SurfaceFields<D>>,
+    ipst: Ipst<D>,
 }
 
 impl<const D: usize> SolidPasses<D> {
@@ -100,7 +105,7 @@ pub fn accelerations<const D: usize>(
     };
     // -(Ma c0) 2h / dt, eq. (36)
     let sun_prefactor = s.shifting.map_or(0.0, |sh| -sh.ma_c0 * 2.0 * h / dt);
-    rates.a_c_dt = s.shifting.map(|_| dt);
+    rates.a_c_dt = s.transports().then_some(dt);
     let gravity = s.gravity_vector::<D>();
     let surface = passes.surface.as_ref().filter(|_| s.free_surface);
     let fixed = &solid.fixed;
@@ -117,7 +122,8 @@ pub fn accelerations<const D: usize>(
         }
         (sums.acc + gravity, ac)
     };
-    if rates.a_c.is_empty() {
+    // Without Sun's shifting the homogenisation is IPST's, or none: only du here.
+    if s.shifting.is_none() {
         rates.du.par_iter_mut().enumerate().with_min_len(MIN_LEN).for_each(|(i, du)| *du = rate(i).0);
     } else {
         rates
@@ -128,6 +134,41 @@ pub fn accelerations<const D: usize>(
             .with_min_len(MIN_LEN)
             .for_each(|(i, (du, ac))| (*du, *ac) = rate(i));
     }
+}
+
+/// IPST's homogenisation of `solid` (eqs. 37-41, for a step `dt`, on step number `step`)
+/// into `rates.a_c`, with its own neighbour list `nl` and binning `cells`, no boundary, and
+/// the free surface the accelerations pass detected (sec. 3.4: the surface particles are
+/// not moved, their neighbours only along it). Fixed particles are not shifted. Does
+/// nothing unless the scheme shifts with IPST; returns the moves made.
+#[allow(clippy::too_many_arguments)]
+pub fn homogenise<const D: usize>(
+    passes: &mut SolidPasses<D>,
+    solid: &ElasticSolid<D>,
+    nl: &KernelList<D>,
+    cells: &CellList<D>,
+    kernel: &Kernel,
+    rates: &mut SolidRates<D>,
+    dt: f64,
+    step: u64,
+) -> usize {
+    if solid.physics.ipst.is_none() {
+        return 0;
+    }
+    let body = Shifted {
+        x: &solid.x,
+        vol: Volumes::MassDensity(&solid.m, &solid.rho),
+        h: solid.h,
+        nl,
+        cells,
+        boundaries: Boundaries::none(),
+    };
+    let moves =
+        passes.ipst.run(body, passes.surface.as_ref(), kernel, solid.physics.ipst, &mut rates.a_c, dt, step);
+    for (ac, _) in rates.a_c.iter_mut().zip(&solid.fixed).filter(|(_, &fixed)| fixed) {
+        *ac = Vector::zeros();
+    }
+    moves
 }
 
 #[cfg(test)]
@@ -176,13 +217,13 @@ mod tests {
 
     /// A stress-free block at rest stays at rest for 1000 steps. Without shifting every
     /// rate is exactly zero (each term is a difference of equal values), so the block does
-    /// not move by a bit. With Sun's shifting the particles near the corners, whose
+    /// not move by a bit. With Sun's shifting (and IPST) the particles near the corners, whose
     /// neighbourhoods are lopsided along the surface too, may be shifted: stated bound, a
     /// largest displacement below 0.01 dx and a largest sqrt(3 J2) and |p| below 1e-6 K.
     #[test]
     fn a_solid_at_rest_stays_at_rest() {
         let dx = 0.01;
-        for pst in [Pst::None, Pst::Sun] {
+        for pst in [Pst::None, Pst::Sun, Pst::Ipst] {
             let init = block(20, 6, dx, |_| Vector::zeros());
             let x0 = init.x.clone();
             let body = solid(init, dx, pst, 1.0);

@@ -4,7 +4,7 @@
 //! values of [`SolidScheme`] built from one [`SolidSettings`]
 //! ([`SolidSchemeName::solid_scheme`]), not separate code paths: they differ in switches.
 
-use super::Pst;
+use super::{paper, IpstTest, Pst, Shifting};
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -66,6 +66,13 @@ pub struct SolidShifting {
     pub n: i32,
 }
 
+/// IPST's tolerance on a solid (eq. 39): 0.2, the authors' code's value outside internal
+/// flows, rather than the fluids' 0.02. An elastic solid's density varies by its
+/// volumetric strain (a bent plate is some per cent denser on its compressed side), which the
+/// fluids' 0.02 reads as disorder: IPST then moves particles across the plate at every step,
+/// as a plastic flow would, and stops it oscillating.
+pub const SOLID_IPST_TOL: f64 = 0.2;
+
 /// What a solid body's equations are (its material constants live on the body).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SolidScheme {
@@ -75,8 +82,12 @@ pub struct SolidScheme {
     pub gradient: GradientVelocity,
     /// The transport-velocity correction terms of eq. (25) and eq. (32).
     pub corrections: bool,
-    /// Particle shifting (the particles then move with u~, eq. 33); `None`: with u.
+    /// Sun's shifting (the particles then move with u~, eq. 33).
     pub shifting: Option<SolidShifting>,
+    /// IPST (eqs. 37-41, [`Shifting::Ipst`]), the other way to make u~; `chi_ref` is set
+    /// from the initial configuration when the simulation starts.
+    #[serde(default)]
+    pub ipst: Option<Shifting>,
     /// Monaghan's artificial viscosity alpha (eq. 28), if any.
     pub artificial_viscosity: Option<f64>,
     /// Monaghan's artificial stress (`gray`), if any.
@@ -89,6 +100,11 @@ pub struct SolidScheme {
 }
 
 impl SolidScheme {
+    /// Whether the particles move with a transport velocity u~ (Sun's shifting or IPST).
+    pub fn transports(&self) -> bool {
+        self.shifting.is_some() || self.ipst.is_some()
+    }
+
     /// Gravity as a `D`-vector.
     pub fn gravity_vector<const D: usize>(&self) -> crate::solver::math::Vector<D> {
         crate::solver::math::Vector::<D>::from_fn(|k, _| self.gravity[k])
@@ -98,7 +114,7 @@ impl SolidScheme {
 /// What a scene gives a solid scheme name to build a [`SolidScheme`] from.
 #[derive(Clone, Copy, Debug)]
 pub struct SolidSettings {
-    /// Particle shifting: Sun 2019 or none (IPST is not wired for solids yet).
+    /// Particle shifting: Sun 2019, IPST or none.
     pub pst: Pst,
     /// The correction terms (read by `ctvf`; `gtvf` has none).
     pub corrections: bool,
@@ -113,9 +129,9 @@ pub struct SolidSettings {
 }
 
 impl SolidSchemeName {
-    /// The composition this name stands for. IPST is refused: its pass reads a fluid's
-    /// views and is not yet given a solid's. `gray` has no transport velocity, so it takes
-    /// `pst` = none only.
+    /// The composition this name stands for. `gray` has no transport velocity, so it takes
+    /// `pst` = none only. IPST runs at the paper's tolerance and cap ([`paper`]) with the
+    /// reference speed `u_ref` as its U_max.
     pub fn solid_scheme(self, s: &SolidSettings) -> Result<SolidScheme, String> {
         if self == SolidSchemeName::Gray && s.pst != Pst::None {
             return Err(format!(
@@ -123,13 +139,17 @@ impl SolidSchemeName {
                 Pst::NAMES[s.pst as usize]
             ));
         }
-        let shifting = match s.pst {
-            Pst::Sun => Some(SolidShifting { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 }),
-            Pst::None => None,
-            Pst::Ipst => {
-                return Err("`pst` = ipst: IPST is not available for solids yet (sun or none)".into())
-            }
-        };
+        let shifting =
+            (s.pst == Pst::Sun).then_some(SolidShifting { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 });
+        let ipst = (s.pst == Pst::Ipst).then_some(Shifting::Ipst {
+            u_max: s.u_ref,
+            tol: SOLID_IPST_TOL,
+            max_iter: paper::IPST_MAX_ITER,
+            interval: paper::IPST_INTERVAL,
+            chi_ref: f64::NAN, // measured on the initial configuration
+            test: IpstTest::default(),
+        });
+        let transports = shifting.is_some() || ipst.is_some();
         let (gradient, corrections) = match self {
             SolidSchemeName::Ctvf => (GradientVelocity::Momentum, s.corrections),
             SolidSchemeName::Gtvf => (GradientVelocity::Transport, false),
@@ -140,11 +160,12 @@ impl SolidSchemeName {
         Ok(SolidScheme {
             name: self,
             gradient,
-            corrections: corrections && shifting.is_some(),
+            corrections: corrections && transports,
             shifting,
+            ipst,
             artificial_viscosity: (s.alpha > 0.0).then_some(s.alpha),
             artificial_stress,
-            free_surface: shifting.is_some(),
+            free_surface: transports,
             gravity: s.gravity,
         })
     }
@@ -185,7 +206,13 @@ impl fmt::Display for SolidScheme {
                 s.n,
                 if self.free_surface { "; tangential near the free surface, eq. (44)" } else { "" }
             ),
-            None => write!(f, "  shifting: none (particles move with u)"),
+            None => match self.ipst {
+                Some(Shifting::Ipst { tol, max_iter, interval, .. }) => write!(
+                    f,
+                    "  shifting: IPST, eqs. (37)-(41): tol = {tol}, max {max_iter} iterations, every {interval} step(s); away from the free surface (sec. 3.4)"
+                ),
+                _ => write!(f, "  shifting: none (particles move with u)"),
+            },
         }
     }
 }
@@ -207,7 +234,8 @@ mod tests {
         assert_eq!((g.gradient, g.corrections), (GradientVelocity::Transport, false));
         let same = SolidScheme { name: c.name, gradient: c.gradient, corrections: c.corrections, ..g };
         assert_eq!(same, c);
-        assert!(SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Ipst)).unwrap_err().contains("ipst"));
+        let ipst = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Ipst)).unwrap();
+        assert!(ipst.shifting.is_none() && ipst.ipst.is_some() && ipst.transports() && ipst.corrections);
         let gray = SolidSchemeName::Gray.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(gray.shifting.is_none() && !gray.corrections && gray.artificial_stress.is_some());
         assert!(SolidSchemeName::Gray.solid_scheme(&settings(Pst::Sun)).unwrap_err().contains("gray"));

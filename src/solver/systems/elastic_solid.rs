@@ -127,7 +127,7 @@ pub struct ElasticSolid<const D: usize> {
     pub x: Vec<Vector<D>>,
     /// Momentum velocity u.
     pub u: Vec<Vector<D>>,
-    /// Transport velocity u~ (eq. 33): only when the scheme shifts.
+    /// Transport velocity u~ (eq. 33): only when the scheme shifts (Sun or IPST).
     pub u_hat: Option<Vec<Vector<D>>>,
     /// Masses.
     pub m: Vec<f64>,
@@ -166,7 +166,7 @@ impl<const D: usize> SolidRates<D> {
             du: vec![Vector::zeros(); n],
             drho: vec![0.0; n],
             ds: vec![Matrix::zeros(); n],
-            a_c: if solid.physics.shifting.is_some() { vec![Vector::zeros(); n] } else { Vec::new() },
+            a_c: if solid.physics.transports() { vec![Vector::zeros(); n] } else { Vec::new() },
             a_c_dt: None,
         }
     }
@@ -205,7 +205,7 @@ impl<const D: usize> ElasticSolid<D> {
             return Err(format!("solid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
         }
         let u = init.u;
-        let u_hat = physics.shifting.is_some().then(|| u.clone());
+        let u_hat = physics.transports().then(|| u.clone());
         let p = init.rho.iter().map(|&r| material.pressure(r)).collect();
         Ok(Self {
             name: name.into(),
