@@ -143,12 +143,18 @@ fn setup(p: &Params) -> Result<Setup, String> {
         .map(|m| m.c0())
         .unwrap_or(0.0);
     let v0 = p.float("v0_over_c0") * c0;
-    let solid = solid_setup(scene, p, v0, v0, [0.0; 3])?;
+    let solid = solid_setup(scene, p, (v0, "`v0_over_c0`"), v0, [0.0; 3])?;
     let dx = solid.dx;
     if sep <= 2.0 * ro {
         return Err(format!(
             "scene `{scene}`: parameter `separation` = {sep:?}: the rings overlap; it must exceed 2 `outer_radius` = {:?}",
             2.0 * ro
+        ));
+    }
+    if sep > 100.0 * ro {
+        return Err(format!(
+            "scene `{scene}`: parameter `separation` = {sep:?}: the rings would not meet; it must not exceed 100 `outer_radius` = {:?}",
+            100.0 * ro
         ));
     }
     let circles = ((ro - ri) / dx).round();

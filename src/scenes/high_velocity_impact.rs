@@ -90,7 +90,7 @@ struct Setup {
 
 fn setup(p: &Params) -> Result<Setup, String> {
     let v0 = p.float("v0");
-    let solid = solid_setup(SCENE, p, v0, v0, [0.0; 3])?;
+    let solid = solid_setup(SCENE, p, (v0, "`v0`"), v0, [0.0; 3])?;
     let dx = solid.dx;
     let (w, t, d) = (p.float("plate_width"), p.float("plate_thickness"), p.float("diameter"));
     let (nxf, nyf) = ((w / dx).round(), (t / dx).round());

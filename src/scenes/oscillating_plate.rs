@@ -121,7 +121,7 @@ fn setup(p: &Params) -> Result<Setup, String> {
         .map(|m| m.c0())
         .unwrap_or(0.0);
     let u = p.float("vf") * c0;
-    let solid = solid_setup(scene, p, u, u, [0.0; 3])?;
+    let solid = solid_setup(scene, p, (u, "`vf`"), u, [0.0; 3])?;
     let dx = solid.dx;
     let (l, hp) = (p.float("length"), p.float("height"));
     // In floating point first: a spacing of 1e-300 m must not overflow a count.

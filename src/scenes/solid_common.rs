@@ -102,11 +102,12 @@ impl SolidSetup {
 /// The setup of scene `scene` from `p`: the material (refused by key: `poisson_ratio`
 /// outside (-1, 0.5), `hdx` outside [0.5, 3]), the scheme, and a check that `tf` needs no
 /// more than [`MAX_STEPS`] steps of eq. (62) at the largest speed `u_max` the scene
-/// expects. `u_ref` is the reference speed of Sun's shifting (eq. 36).
+/// expects, which the parameters `u_keys` (e.g. "`v0`") set. `u_ref` is the reference speed
+/// of Sun's shifting (eq. 36).
 pub fn solid_setup(
     scene: &str,
     p: &Params,
-    u_max: f64,
+    (u_max, u_keys): (f64, &str),
     u_ref: f64,
     gravity: [f64; 3],
 ) -> Result<SolidSetup, String> {
@@ -139,7 +140,7 @@ pub fn solid_setup(
     let steps = p.float("tf") / dt;
     if steps.is_nan() || steps > MAX_STEPS {
         return Err(format!(
-            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, h = `hdx` `dx`: more than {MAX_STEPS:e}",
+            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, |u| = {u_max:.3e} m/s from {u_keys}, h = `hdx` `dx`: more than {MAX_STEPS:e}",
             p.float("tf"),
             material.c0()
         ));

@@ -133,7 +133,7 @@ fn setup(p: &Params) -> Result<Setup, String> {
     }
     // The largest speed: free fall over the flag's length, sqrt(2 g l).
     let u = (2.0 * g * l).sqrt();
-    let solid = solid_setup(scene, p, u, u.max(1e-3), [0.0, -g, 0.0])?;
+    let solid = solid_setup(scene, p, (u, "`gravity` and `length`"), u.max(1e-3), [0.0, -g, 0.0])?;
     let dx = solid.dx;
     let (nxf, nyf) = ((l / dx).round(), (hf / dx).round());
     let flag = format!("the flag (`length` = {l:?}, `height` = {hf:?}) at `dx` = {dx:?}");
