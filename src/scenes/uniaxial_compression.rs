@@ -112,7 +112,7 @@ fn setup(p: &Params) -> Result<Setup, String> {
     // or fail without naming it.
     if let Ok(m) = SolidMaterial::new(p.float("youngs_modulus"), p.float("poisson_ratio"), p.float("density"))
     {
-        if !(v < 0.1 * m.c0()) {
+        if v.is_nan() || v >= 0.1 * m.c0() {
             return Err(format!(
                 "scene `{SCENE}`: parameter `piston_speed` = {v:?}: must be below 0.1 c0 = {:.4e} m/s (c0 from `youngs_modulus`, `poisson_ratio` and `density`) for a compression, not an impact",
                 0.1 * m.c0()

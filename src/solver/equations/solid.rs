@@ -160,8 +160,8 @@ pub fn von_mises<const D: usize>(s: &Matrix<D>) -> f64 {
 }
 
 /// The von Mises stress of a 2D total stress `sigma` from its principal stresses
-/// (eqs. 68-70): `sqrt(s1^2 + s2^2 - s1 s2)`, `s1,2 = (sxx + syy)/2 +- sqrt(((sxx - syy)/2)^2
-/// + sxy^2)`. Eqs. (69)-(70) print `((sxx + syy)/2)^2` under the root, which is not the
+/// (eqs. 68-70): `sqrt(s1^2 + s2^2 - s1 s2)` with
+/// `s1,2 = (sxx + syy)/2 +- sqrt(((sxx - syy)/2)^2 + sxy^2)`. Eqs. (69)-(70) print `((sxx + syy)/2)^2` under the root, which is not the
 /// principal stresses' formula (Mohr's circle has radius `(sxx - syy)/2`); the two agree
 /// when one of sxx, syy is zero and sxy is, as at the centre of a uniaxial specimen.
 pub fn von_mises_principal(sigma: &Matrix<2>) -> f64 {
