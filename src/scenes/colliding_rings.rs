@@ -222,8 +222,8 @@ struct Rings {
     u0: f64,
     e0: f64,
     energy_err: f64,
-    clusters_max: usize,
-    max_gap: f64,
+    /// The fracture detector's worst over the run.
+    fracture: fracture::Worst,
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
@@ -262,8 +262,7 @@ fn rings(p: &Params) -> Result<Rings, String> {
         u0: 0.0,
         e0: 0.0,
         energy_err: 0.0,
-        clusters_max: 0,
-        max_gap: 0.0,
+        fracture: fracture::Worst::default(),
     };
     run.u0 = run.u_left();
     run.e0 = energy(run.solid());
@@ -289,10 +288,8 @@ impl Rings {
     }
 
     fn fracture(&mut self) -> fracture::Fracture {
-        let f = fracture::detect(&self.solid().x, self.dx, LINK);
-        self.clusters_max = self.clusters_max.max(f.clusters);
-        self.max_gap = self.max_gap.max(f.max_gap);
-        f
+        let x = &self.sim.solid(RINGS).expect("the body").0.x;
+        self.fracture.observe(x, self.dx, LINK)
     }
 }
 
@@ -331,28 +328,28 @@ impl SceneRun for Rings {
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
         // The detector at the end too, whatever the sampling.
-        let end = fracture::detect(&self.solid().x, self.dx, LINK);
-        BTreeMap::from([
-            ("clusters_max".to_string(), self.clusters_max.max(end.clusters) as f64),
-            ("max_gap".to_string(), self.max_gap.max(end.max_gap)),
+        let worst = self.fracture.with(&self.solid().x, self.dx, LINK);
+        let mut m = BTreeMap::from(worst.metrics());
+        m.extend([
             ("rebound_speed_ratio".to_string(), -self.u_left() / self.u0),
             ("energy_rel_error".to_string(), self.energy_err),
-        ])
+        ]);
+        m
     }
     fn save_state(&self) -> serde_json::Value {
         serde_json::json!({
             "sim": &self.sim.state,
             "energy_err": self.energy_err,
-            "clusters_max": self.clusters_max,
-            "max_gap": self.max_gap,
+            "clusters_max": self.fracture.clusters_max,
+            "max_gap": self.fracture.max_gap,
         })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
         let get = |k: &str| state[k].clone();
         let err = |e: serde_json::Error| format!("checkpoint: {e}");
         self.energy_err = serde_json::from_value(get("energy_err")).map_err(err)?;
-        self.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
-        self.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
+        self.fracture.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
+        self.fracture.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
         restore_sim(&mut self.sim, &state)
     }
 }

@@ -170,8 +170,8 @@ struct Plate {
     /// (t, tip_y) at the last step, and the zero crossings of tip_y so far.
     last: (f64, f64),
     crossings: Vec<f64>,
-    clusters_max: usize,
-    max_gap: f64,
+    /// The fracture detector's worst over the run.
+    fracture: fracture::Worst,
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
@@ -216,8 +216,7 @@ fn plate(p: &Params) -> Result<Plate, String> {
         tip,
         last: (0.0, 0.0),
         crossings: Vec::new(),
-        clusters_max: 0,
-        max_gap: 0.0,
+        fracture: fracture::Worst::default(),
     };
     run.last = (0.0, run.tip_y());
     Ok(run)
@@ -245,10 +244,8 @@ impl Plate {
     }
 
     fn fracture(&mut self) -> fracture::Fracture {
-        let f = fracture::detect(&self.solid().x, self.dx, LINK);
-        self.clusters_max = self.clusters_max.max(f.clusters);
-        self.max_gap = self.max_gap.max(f.max_gap);
-        f
+        let x = &self.sim.solid(PLATE).expect("the body").0.x;
+        self.fracture.observe(x, self.dx, LINK)
     }
 
     fn paper_plate(&self) -> bool {
@@ -288,14 +285,11 @@ impl SceneRun for Plate {
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
         // The detector at the end too, whatever the sampling.
-        let end = fracture::detect(&self.solid().x, self.dx, LINK);
+        let worst = self.fracture.with(&self.solid().x, self.dx, LINK);
         let material = self.solid().material;
         let theory = thin_plate_period(&material, self.length, self.height);
-        let mut m = BTreeMap::from([
-            ("clusters_max".to_string(), self.clusters_max.max(end.clusters) as f64),
-            ("max_gap".to_string(), self.max_gap.max(end.max_gap)),
-            ("period_theory".to_string(), theory),
-        ]);
+        let mut m = BTreeMap::from(worst.metrics());
+        m.insert("period_theory".into(), theory);
         if let Some(t) = period_from_crossings(&self.crossings) {
             m.insert("period".into(), t);
             m.insert("period_rel_error_theory".into(), (t - theory).abs() / theory);
@@ -311,8 +305,8 @@ impl SceneRun for Plate {
             "sim": &self.sim.state,
             "last": self.last,
             "crossings": &self.crossings,
-            "clusters_max": self.clusters_max,
-            "max_gap": self.max_gap,
+            "clusters_max": self.fracture.clusters_max,
+            "max_gap": self.fracture.max_gap,
         })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
@@ -320,8 +314,8 @@ impl SceneRun for Plate {
         let err = |e: serde_json::Error| format!("checkpoint: {e}");
         self.last = serde_json::from_value(get("last")).map_err(err)?;
         self.crossings = serde_json::from_value(get("crossings")).map_err(err)?;
-        self.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
-        self.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
+        self.fracture.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
+        self.fracture.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
         restore_sim(&mut self.sim, &state)
     }
 }

@@ -25,6 +25,39 @@ pub struct Fracture {
     pub max_gap: f64,
 }
 
+/// The worst of [`detect`] over a run: the largest cluster count and the largest gap seen,
+/// for the `clusters_max` and `max_gap` metrics of the solid scenes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Worst {
+    /// The largest number of clusters seen.
+    pub clusters_max: usize,
+    /// The largest nearest-neighbour distance seen, in units of `dx`.
+    pub max_gap: f64,
+}
+
+impl Worst {
+    /// [`detect`] at `x` now, folded into the worst so far; returns what it found.
+    pub fn observe<const D: usize>(&mut self, x: &[Vector<D>], dx: f64, link: f64) -> Fracture {
+        let f = detect(x, dx, link);
+        self.clusters_max = self.clusters_max.max(f.clusters);
+        self.max_gap = self.max_gap.max(f.max_gap);
+        f
+    }
+
+    /// The worst so far together with [`detect`] at `x` (the end of a run, whatever the
+    /// sampling), without changing the record.
+    pub fn with<const D: usize>(&self, x: &[Vector<D>], dx: f64, link: f64) -> Worst {
+        let mut w = *self;
+        w.observe(x, dx, link);
+        w
+    }
+
+    /// The `clusters_max` and `max_gap` metrics.
+    pub fn metrics(&self) -> [(String, f64); 2] {
+        [("clusters_max".into(), self.clusters_max as f64), ("max_gap".into(), self.max_gap)]
+    }
+}
+
 /// The clusters and largest gap of the particles at `x` (initial spacing `dx`), two
 /// particles being connected when closer than `link * dx`.
 pub fn detect<const D: usize>(x: &[Vector<D>], dx: f64, link: f64) -> Fracture {
