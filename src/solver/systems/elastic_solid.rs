@@ -183,27 +183,14 @@ impl<const D: usize> ElasticSolid<D> {
         physics: SolidScheme,
     ) -> Result<Self, String> {
         let n = init.x.len();
-        if n == 0 {
-            return Err(format!("solid `{name}`: no particles"));
-        }
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(format!("solid `{name}`: smoothing length h = {h} must be positive"));
-        }
-        for (field, len) in
-            [("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("fixed", init.fixed.len())]
-        {
-            if len != n {
-                return Err(format!("solid `{name}`: {field} has {len} entries for {n} particles"));
-            }
-        }
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if let Some(i) = init.m.iter().position(|&m| !(m > 0.0)) {
-            return Err(format!("solid `{name}`: particle {i} has non-positive mass {}", init.m[i]));
-        }
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
-            return Err(format!("solid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
-        }
+        super::check_init(
+            ("solid", name),
+            n,
+            h,
+            &[("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("fixed", init.fixed.len())],
+            &init.m,
+            &init.rho,
+        )?;
         let u = init.u;
         let u_hat = physics.transports().then(|| u.clone());
         let p = init.rho.iter().map(|&r| material.pressure(r)).collect();

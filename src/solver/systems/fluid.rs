@@ -125,28 +125,14 @@ impl<const D: usize> Fluid<D> {
     /// offending field.
     pub fn new(name: &str, h: f64, init: FluidInit<D>, physics: FluidScheme) -> Result<Self, String> {
         let n = init.x.len();
-        if n == 0 {
-            return Err(format!("fluid `{name}`: no particles"));
-        }
-        if !(h > 0.0 && h.is_finite()) {
-            return Err(format!("fluid `{name}`: smoothing length h = {h} must be positive"));
-        }
-        for (field, len) in
-            [("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("p", init.p.len())]
-        {
-            if len != n {
-                return Err(format!("fluid `{name}`: {field} has {len} entries for {n} particles"));
-            }
-        }
-        // `!(v > 0.0)` also rejects NaN.
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if let Some(i) = init.m.iter().position(|&m| !(m > 0.0)) {
-            return Err(format!("fluid `{name}`: particle {i} has non-positive mass {}", init.m[i]));
-        }
-        #[allow(clippy::neg_cmp_op_on_partial_ord)]
-        if let Some(i) = init.rho.iter().position(|&r| !(r > 0.0)) {
-            return Err(format!("fluid `{name}`: particle {i} has non-positive density {}", init.rho[i]));
-        }
+        super::check_init(
+            ("fluid", name),
+            n,
+            h,
+            &[("u", init.u.len()), ("m", init.m.len()), ("rho", init.rho.len()), ("p", init.p.len())],
+            &init.m,
+            &init.rho,
+        )?;
         if n > u32::MAX as usize {
             return Err(format!("fluid `{name}`: {n} particles are more than a body indexes"));
         }

@@ -23,6 +23,41 @@ pub use elastic_solid::{ElasticSolid, SolidInit, SolidMaterial, SolidRates};
 pub use fluid::{Fluid, FluidInit, FluidPart, FluidRates};
 pub use wall::{Wall, WallMotion};
 
+/// The checks every integrated body's initial values pass, with errors naming the body
+/// (`kind` `name`) and the offending field: some particles, a positive finite smoothing
+/// length, every per-particle field (`fields`: name and length) as long as the positions
+/// (`n`), and positive masses and densities (NaN refused too).
+pub(crate) fn check_init(
+    (kind, name): (&str, &str),
+    n: usize,
+    h: f64,
+    fields: &[(&str, usize)],
+    m: &[f64],
+    rho: &[f64],
+) -> Result<(), String> {
+    if n == 0 {
+        return Err(format!("{kind} `{name}`: no particles"));
+    }
+    if !(h > 0.0 && h.is_finite()) {
+        return Err(format!("{kind} `{name}`: smoothing length h = {h} must be positive"));
+    }
+    for &(field, len) in fields {
+        if len != n {
+            return Err(format!("{kind} `{name}`: {field} has {len} entries for {n} particles"));
+        }
+    }
+    // `!(v > 0.0)` also rejects NaN.
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if let Some(i) = m.iter().position(|&m| !(m > 0.0)) {
+        return Err(format!("{kind} `{name}`: particle {i} has non-positive mass {}", m[i]));
+    }
+    #[allow(clippy::neg_cmp_op_on_partial_ord)]
+    if let Some(i) = rho.iter().position(|&r| !(r > 0.0)) {
+        return Err(format!("{kind} `{name}`: particle {i} has non-positive density {}", rho[i]));
+    }
+    Ok(())
+}
+
 use crate::solver::math::Vector;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
