@@ -35,6 +35,21 @@ impl<const D: usize> WallSums<D> {
         self.u += u * w;
         self.u_hat += u_hat * w;
     }
+
+    /// The extrapolated pressure of eq. (52) (eq. 4.14 of the thesis for a structure) for a
+    /// particle at acceleration `a_w` under gravity `g`, and the kernel-weighted mean fluid
+    /// velocity and transport velocity around it: zero for a particle with no fluid
+    /// neighbour.
+    #[inline(always)]
+    pub fn extrapolated(&self, a_w: Vector<D>, g: Vector<D>) -> (f64, Vector<D>, Vector<D>) {
+        if self.w > 1e-300 {
+            let inv = 1.0 / self.w;
+            // p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W
+            ((self.p + (g - a_w).dot(&self.rho_r)) * inv, self.u * inv, self.u_hat * inv)
+        } else {
+            (0.0, Vector::zeros(), Vector::zeros())
+        }
+    }
 }
 
 /// The values a wall particle presents to the fluid.
@@ -68,13 +83,7 @@ pub fn ghost<const D: usize>(
     n: Vector<D>,
     g: Vector<D>,
 ) -> Ghost<D> {
-    let (p, u_f, u_hat_f) = if s.w > 1e-300 {
-        let inv = 1.0 / s.w;
-        // eq. (52): p_w = (sum p_f W + (g - a_w) . sum rho_f r_wf W) / sum W
-        ((s.p + (g - a_w).dot(&s.rho_r)) * inv, s.u * inv, s.u_hat * inv)
-    } else {
-        (0.0, Vector::zeros(), Vector::zeros())
-    };
+    let (p, u_f, u_hat_f) = s.extrapolated(a_w, g);
     let u_n = if sliding { 0.0 } else { u_p.dot(&n) };
     Ghost {
         p,
@@ -85,6 +94,24 @@ pub fn ghost<const D: usize>(
         // eq. (50): the whole velocity mirrored about the wall's
         u_noslip: u_p * 2.0 - u_f,
     }
+}
+
+/// What a particle of a deforming structure presents to the fluid (Adami et al. 2012 with
+/// the structure's own motion; thesis sec. 4.2.4): the pressure of eq. (4.14) at the
+/// particle's acceleration `a_s`, its own velocity `u_s` and transport velocity `u_hat_s`
+/// to the divergence terms (a structure has no fixed normal to mirror about, so the fluid's
+/// continuity sees the structure's motion itself, as the thesis's code does), and the
+/// no-slip mirror `2 u_s - u_f` of eq. (50) to the viscous terms.
+#[inline(always)]
+pub fn structure_ghost<const D: usize>(
+    s: &WallSums<D>,
+    u_s: Vector<D>,
+    u_hat_s: Vector<D>,
+    a_s: Vector<D>,
+    g: Vector<D>,
+) -> Ghost<D> {
+    let (p, u_f, _) = s.extrapolated(a_s, g);
+    Ghost { p, u_slip: u_s, u_hat_slip: u_hat_s, u_noslip: u_s * 2.0 - u_f }
 }
 
 #[cfg(test)]

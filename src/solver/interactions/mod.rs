@@ -9,6 +9,9 @@
 //! - [`fluid_boundary`]: a fluid reading a boundary's extrapolated values as neighbours;
 //! - [`boundary_fluid`]: a boundary extrapolating its values from a fluid (eqs. 46-52);
 //! - [`solid_solid`]: an elastic solid's particles among themselves, eqs. (25), (30)-(32);
+//! - [`structure_fluid`]: an elastic solid in a fluid, extrapolating its pressure from the
+//!   fluid (thesis eq. 4.14) and taking the reaction of the fluid's pair force (eq. 4.15);
+//!   the fluid reads it as a boundary ([`fluid_boundary`]);
 //! - [`lists`]: the neighbour lists with their kernel values, shared by all of them.
 //!
 //! Reactions stay deterministic without atomics: every pass is a gather, each particle
@@ -19,6 +22,7 @@ pub mod fluid_boundary;
 pub mod fluid_fluid;
 pub mod lists;
 pub mod solid_solid;
+pub mod structure_fluid;
 
 use crate::solver::systems::BodyKind;
 
@@ -37,6 +41,10 @@ pub enum Interaction {
     /// An elastic solid's particles among themselves: density, stress and momentum
     /// (eqs. 25, 30-32), shifting and free-surface detection ([`solid_solid`]).
     SolidSolid,
+    /// A structure (an elastic solid) in a fluid: it extrapolates its pressure from the
+    /// fluid (thesis eq. 4.14) and takes the reaction of the fluid's pair force (eq. 4.15)
+    /// ([`structure_fluid`]).
+    StructureFluid,
 }
 
 /// How body kind `dst` is acted on by body kind `src` (`None`: not at all). For two bodies
@@ -52,9 +60,10 @@ pub fn interaction(dst: BodyKind, src: BodyKind) -> Option<Interaction> {
         // Within one solid (the simulation pairs a solid only with itself: contact between
         // two solid bodies is not modelled yet, so two solids pass through each other).
         (ElasticSolid, ElasticSolid) => Some(Interaction::SolidSolid),
-        // Fluid-structure coupling is a later stage: a fluid and a solid do not see each
-        // other yet.
-        (Fluid, ElasticSolid) | (ElasticSolid, Fluid) => None,
+        // Fluid-structure interaction (thesis sec. 4.2.4): the fluid reads the structure
+        // as a boundary, the structure takes the opposite of the fluid's pair force.
+        (Fluid, ElasticSolid) => Some(Interaction::FluidBoundary),
+        (ElasticSolid, Fluid) => Some(Interaction::StructureFluid),
         // Solid-wall contact is a later stage too (a clamp is made of the solid's own fixed
         // particles, see `systems::elastic_solid`).
         (ElasticSolid, Wall) | (Wall, ElasticSolid) => None,
@@ -66,7 +75,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn a_fluid_and_a_wall_act_on_each_other_and_walls_on_nothing() {
+    fn who_acts_on_whom() {
         use BodyKind::{Fluid, Wall};
         assert_eq!(interaction(Fluid, Fluid), Some(Interaction::FluidFluid));
         assert_eq!(interaction(Fluid, Wall), Some(Interaction::FluidBoundary));
@@ -74,8 +83,8 @@ mod tests {
         assert_eq!(interaction(Wall, Wall), None);
         use BodyKind::ElasticSolid;
         assert_eq!(interaction(ElasticSolid, ElasticSolid), Some(Interaction::SolidSolid));
-        for other in [Fluid, Wall] {
-            assert_eq!((interaction(ElasticSolid, other), interaction(other, ElasticSolid)), (None, None));
-        }
+        assert_eq!((interaction(ElasticSolid, Wall), interaction(Wall, ElasticSolid)), (None, None));
+        assert_eq!(interaction(Fluid, ElasticSolid), Some(Interaction::FluidBoundary));
+        assert_eq!(interaction(ElasticSolid, Fluid), Some(Interaction::StructureFluid));
     }
 }

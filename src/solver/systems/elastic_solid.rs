@@ -17,6 +17,7 @@
 //! (sec. 4.7): after every stress update the deviatoric stress is returned radially onto
 //! the von Mises surface ([`radial_return`]).
 
+use super::boundary::{BoundaryMaterial, BoundaryModel};
 use crate::solver::equations::solid::radial_return;
 use crate::solver::integrator;
 use crate::solver::math::{Matrix, Vector};
@@ -140,6 +141,11 @@ pub struct ElasticSolid<const D: usize> {
     /// Moved at the velocity it was given (a clamp, a piston): zero acceleration and
     /// shifting.
     pub fixed: Vec<bool>,
+    /// What the particles present to a fluid they meet (a structure in water): dummy
+    /// particles of the fluid's density whose pressure is extrapolated from the fluid
+    /// (thesis sec. 4.2.4, eq. 4.14); `None` for a solid no fluid sees.
+    #[serde(default)]
+    pub boundary: Option<BoundaryModel<D>>,
 }
 
 /// Time derivatives of a solid body, owned by the simulation.
@@ -156,6 +162,11 @@ pub struct SolidRates<const D: usize> {
     /// The step eq. (36) divided (du/dt)_c by (see
     /// [`FluidRates::a_c_dt`](super::FluidRates::a_c_dt)).
     pub a_c_dt: Option<f64>,
+    /// The fluid's force on each particle per unit mass, F_FSI / m of eq. (4.6) (the
+    /// opposite of eq. 4.15), included in `du`; empty for a solid no fluid acts on. Held
+    /// over a structure's sub-steps (see [`Simulation`](crate::solver::simulation)).
+    #[serde(default)]
+    pub a_fsi: Vec<Vector<D>>,
 }
 
 impl<const D: usize> SolidRates<D> {
@@ -168,6 +179,7 @@ impl<const D: usize> SolidRates<D> {
             ds: vec![Matrix::zeros(); n],
             a_c: if solid.physics.transports() { vec![Vector::zeros(); n] } else { Vec::new() },
             a_c_dt: None,
+            a_fsi: if solid.boundary.is_some() { vec![Vector::zeros(); n] } else { Vec::new() },
         }
     }
 }
@@ -207,7 +219,23 @@ impl<const D: usize> ElasticSolid<D> {
             p,
             s: vec![Matrix::zeros(); n],
             fixed: init.fixed,
+            boundary: None,
         })
+    }
+
+    /// The solid as a structure a fluid meets (thesis sec. 4.2.4): its particles present
+    /// themselves to the fluid as boundary particles of `material` (the fluid's reference
+    /// density and sound speed, and the wall models of the scene), each of mass
+    /// `rho0_fluid V` for its volume `V = m / rho`, as the thesis's code sets them, so that
+    /// the fluid sees a boundary of its own density.
+    pub fn facing_fluid(mut self, material: BoundaryMaterial) -> Result<Self, String> {
+        let mut model = BoundaryModel::new(self.len(), 1.0, material.rho0, material.c0)
+            .map_err(|e| format!("solid `{}`: {e}", self.name))?;
+        model.material = material;
+        model.m = self.m.iter().zip(&self.rho).map(|(m, rho)| material.rho0 * m / rho).collect();
+        model.resize();
+        self.boundary = Some(model);
+        Ok(self)
     }
 
     /// Number of particles.

@@ -161,11 +161,12 @@ impl<const D: usize> Body<D> {
     }
 
     /// The body as a boundary a fluid reads: its positions and what they present (a
-    /// wall's extrapolated values); `None` for a body that is not one.
+    /// wall's or a structure's extrapolated values); `None` for a body that is not one.
     pub fn as_boundary(&self) -> Option<(&[Vector<D>], &BoundaryModel<D>)> {
         match self {
             Body::Wall(w) => Some((&w.x, &w.boundary)),
-            Body::Fluid(_) | Body::ElasticSolid(_) => None,
+            Body::ElasticSolid(s) => s.boundary.as_ref().map(|b| (&s.x[..], b)),
+            Body::Fluid(_) => None,
         }
     }
 
