@@ -756,3 +756,23 @@ pub fn wall_params() -> Vec<Spec> {
         .added_later(),
     ]
 }
+
+/// The RMS deviation of a sampled curve `ours` (time, value; in time order) from the points
+/// `reference` within its time range: ours interpolated linearly at each reference time
+/// (the first sample's value before it); reference points after our last sample are
+/// skipped. `None` when no reference point falls in range.
+pub fn rms_deviation(ours: &[(f64, f64)], reference: &[(f64, f64)]) -> Option<f64> {
+    let (mut sum2, mut n) = (0.0, 0);
+    for &(ts, z) in reference {
+        let Some(i) = ours.iter().position(|&(t, _)| t >= ts) else { continue };
+        let value = if i == 0 {
+            ours[0].1
+        } else {
+            let ((t0, z0), (t1, z1)) = (ours[i - 1], ours[i]);
+            z0 + (z1 - z0) * (ts - t0) / (t1 - t0).max(1e-300)
+        };
+        sum2 += (value - z).powi(2);
+        n += 1;
+    }
+    (n > 0).then(|| (sum2 / n as f64).sqrt())
+}

@@ -17,8 +17,8 @@
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
 use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, simulation,
-    snapshot_bodies, surface_fields, wall_params, FluidConstants,
+    forward_to_sim, free_surface_params, plan, restore_sim, rms_deviation, scheme_params, shifting_columns,
+    simulation, snapshot_bodies, surface_fields, wall_params, FluidConstants,
 };
 use super::params::{Bound, Params, Spec};
 use super::tank::{Column, G, LAYERS};
@@ -150,19 +150,7 @@ impl DamBreak {
     /// RMS of our Z/L minus Koshizuka's at their times within our sampled range (all of
     /// theirs unless the run ends before t* = 3.1).
     fn toe_rms(&self) -> Option<f64> {
-        let (mut sum2, mut n) = (0.0, 0);
-        for (ts, z) in koshizuka() {
-            let Some(i) = self.toe.iter().position(|&(t, _)| t >= ts) else { continue };
-            let ours = if i == 0 {
-                self.toe[0].1
-            } else {
-                let ((t0, z0), (t1, z1)) = (self.toe[i - 1], self.toe[i]);
-                z0 + (z1 - z0) * (ts - t0) / (t1 - t0).max(1e-300)
-            };
-            sum2 += (ours - z).powi(2);
-            n += 1;
-        }
-        (n > 0).then(|| (sum2 / n as f64).sqrt())
+        rms_deviation(&self.toe, &koshizuka())
     }
 }
 

@@ -7,10 +7,14 @@ pub mod cavity;
 pub mod colliding_rings;
 pub mod common;
 pub mod dam_break;
+pub mod dam_break_elastic_plate;
+pub mod elastic_gate;
 pub mod free_surface_demo;
+pub mod fsi_common;
 pub mod geometry;
 pub mod harness;
 pub mod high_velocity_impact;
+pub mod hydrostatic_plate;
 pub mod hydrostatic_tank;
 pub mod oscillating_plate;
 pub mod params;
@@ -105,6 +109,9 @@ pub const SCENES: &[SceneEntry] = &[
     colliding_rings::ENTRY,
     high_velocity_impact::ENTRY,
     turek_csm3::ENTRY,
+    hydrostatic_plate::ENTRY,
+    dam_break_elastic_plate::ENTRY,
+    elastic_gate::ENTRY,
 ];
 
 /// Looks a scene up by name.

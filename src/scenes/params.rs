@@ -48,6 +48,11 @@ pub enum Kind {
     Bool,
     /// One of the listed names.
     Choice(&'static [&'static str]),
+    /// `auto` or an integer `>= min` (a count the scene may work out itself).
+    AutoOrInt {
+        /// Smallest accepted value.
+        min: i64,
+    },
 }
 
 /// A lower bound on a float parameter.
@@ -125,6 +130,18 @@ impl Spec {
         }
     }
 
+    /// A parameter that is `auto` (its default) or an integer `>= min`.
+    pub fn auto_or_int(name: &'static str, min: i64, help: &'static str) -> Self {
+        Self {
+            name,
+            kind: Kind::AutoOrInt { min },
+            default: Value::Str("auto".into()),
+            help,
+            added_later: false,
+            max: None,
+        }
+    }
+
     /// The parameter marked [`added_later`](Self::added_later).
     pub fn added_later(self) -> Self {
         Self { added_later: true, ..self }
@@ -152,6 +169,7 @@ impl Spec {
             Kind::Float { bound: Bound::None } => "number".into(),
             Kind::Bool => "true|false".into(),
             Kind::Choice(c) => c.join("|"),
+            Kind::AutoOrInt { min } => format!("auto|integer >= {min}"),
         }
     }
 
@@ -197,6 +215,9 @@ impl Spec {
             (Kind::Bool, _) => Err(bad("expected true or false")),
             (Kind::Choice(c), Value::Str(s)) if c.contains(&s.as_str()) => Ok(v.clone()),
             (Kind::Choice(c), _) => Err(bad(&format!("expected one of {}", c.join(", ")))),
+            (Kind::AutoOrInt { .. }, Value::Str(s)) if s == "auto" => Ok(v.clone()),
+            (Kind::AutoOrInt { min }, Value::Int(i)) if *i >= min => Ok(v.clone()),
+            (Kind::AutoOrInt { min }, _) => Err(bad(&format!("expected auto or an integer >= {min}"))),
         }
     }
 
@@ -204,7 +225,9 @@ impl Spec {
     pub fn parse(&self, scene: &str, s: &str) -> Result<Value, String> {
         let s = s.trim();
         let v = match self.kind {
-            Kind::Int { .. } => s.parse::<i64>().map(Value::Int).unwrap_or_else(|_| Value::Str(s.into())),
+            Kind::Int { .. } | Kind::AutoOrInt { .. } => {
+                s.parse::<i64>().map(Value::Int).unwrap_or_else(|_| Value::Str(s.into()))
+            }
             Kind::Float { .. } => s.parse::<f64>().map(Value::Float).unwrap_or_else(|_| Value::Str(s.into())),
             Kind::Bool => match s {
                 "true" => Value::Bool(true),
@@ -280,6 +303,15 @@ impl Params {
         match self.get(key) {
             Value::Bool(b) => *b,
             v => panic!("parameter `{key}` = {v} is not a boolean"),
+        }
+    }
+
+    /// An `auto`-or-integer parameter: `None` for `auto`.
+    pub fn auto_or_int(&self, key: &str) -> Option<i64> {
+        match self.get(key) {
+            Value::Int(i) => Some(*i),
+            Value::Str(s) if s == "auto" => None,
+            v => panic!("parameter `{key}` = {v} is neither auto nor an integer"),
         }
     }
 

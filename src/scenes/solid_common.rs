@@ -32,19 +32,70 @@ pub struct SolidDefaults {
     pub pst: &'static str,
 }
 
+/// The names a solid's parameters go by: a solid scene's own, or those of a structure in a
+/// fluid, whose scheme takes the plain names ([`STRUCTURE`]).
+#[derive(Clone, Copy, Debug)]
+pub struct SolidKeys {
+    /// Whether the solid declares the spacing `dx` and `hdx` (a structure shares the
+    /// fluid's).
+    pub own_spacing: bool,
+    /// Reference density.
+    pub density: &'static str,
+    /// Artificial viscosity alpha.
+    pub alpha: &'static str,
+    /// The scheme.
+    pub scheme: &'static str,
+    /// The shifting.
+    pub pst: &'static str,
+    /// The correction terms.
+    pub corrections: &'static str,
+}
+
+/// A solid scene's parameter names.
+pub const SOLID: SolidKeys = SolidKeys {
+    own_spacing: true,
+    density: "density",
+    alpha: "alpha",
+    scheme: "scheme",
+    pst: "pst",
+    corrections: "corrections",
+};
+
+/// The parameter names of a structure in a fluid: prefixed `solid_` where the fluid's
+/// scheme takes the plain name.
+pub const STRUCTURE: SolidKeys = SolidKeys {
+    own_spacing: false,
+    density: "solid_density",
+    alpha: "solid_alpha",
+    scheme: "solid_scheme",
+    pst: "solid_pst",
+    corrections: "solid_corrections",
+};
+
 /// The shifting choices of a solid.
 pub const SOLID_PST: &[&str] = &["sun", "ipst", "none"];
 
 /// The parameters of a solid scene with defaults `d` (the scene's own come before them and
 /// the common ones after).
 pub fn solid_params(d: &SolidDefaults) -> Vec<Spec> {
-    let mut v = vec![
-        Spec::float("dx", d.dx, Bound::Positive, "particle spacing (m)"),
-        Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
+    solid_params_as(d, &SOLID)
+}
+
+/// The parameters of a solid with defaults `d` under the names `k` (without the spacing for
+/// a structure: `d.dx` is then unused).
+pub fn solid_params_as(d: &SolidDefaults, k: &SolidKeys) -> Vec<Spec> {
+    let mut v = Vec::new();
+    if k.own_spacing {
+        v.extend([
+            Spec::float("dx", d.dx, Bound::Positive, "particle spacing (m)"),
+            Spec::float("hdx", 1.0, Bound::Positive, "h / dx"),
+        ]);
+    }
+    v.extend([
         Spec::float("youngs_modulus", d.youngs_modulus, Bound::Positive, "Young's modulus E (Pa)"),
         Spec::float("poisson_ratio", d.poisson_ratio, Bound::None, "Poisson's ratio nu, in (-1, 0.5)"),
-        Spec::float("density", d.density, Bound::Positive, "reference density rho0 (kg/m^3)"),
-    ];
+        Spec::float(k.density, d.density, Bound::Positive, "reference density rho0 (kg/m^3)"),
+    ]);
     if let Some(y0) = d.yield_stress {
         v.push(Spec::float(
             "yield_stress",
@@ -54,21 +105,21 @@ pub fn solid_params(d: &SolidDefaults) -> Vec<Spec> {
         ));
     }
     v.extend([
-        Spec::float("alpha", d.alpha, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
+        Spec::float(k.alpha, d.alpha, Bound::NonNegative, "artificial viscosity alpha, eq. (28)"),
         Spec::choice(
-            "scheme",
+            k.scheme,
             SolidSchemeName::NAMES,
             "ctvf",
             "solid scheme: ctvf (eq. 31 of u, corrections), gtvf (of u~, none) or gray (no transport velocity, Monaghan's artificial stress)",
         ),
         Spec::choice(
-            "pst",
+            k.pst,
             SOLID_PST,
             d.pst,
             "particle shifting: Sun 2019 (eq. 36), IPST (sec. 3.3) or none (gray: none)",
         ),
         Spec::choice(
-            "corrections",
+            k.corrections,
             &["all", "none"],
             "all",
             "the CTVF correction terms of eqs. (25) and (32) (ctvf)",
@@ -107,9 +158,20 @@ impl SolidSetup {
 pub fn solid_setup(
     scene: &str,
     p: &Params,
-    (u_max, u_keys): (f64, &str),
+    u_max: (f64, &str),
     u_ref: f64,
     gravity: [f64; 3],
+) -> Result<SolidSetup, String> {
+    solid_setup_as(scene, p, &SOLID, u_max, (u_ref, gravity))
+}
+
+/// As [`solid_setup`] for the parameters named `k`.
+pub fn solid_setup_as(
+    scene: &str,
+    p: &Params,
+    k: &SolidKeys,
+    (u_max, u_keys): (f64, &str),
+    (u_ref, gravity): (f64, [f64; 3]),
 ) -> Result<SolidSetup, String> {
     let bad =
         |key: &str, why: &str| Err(format!("scene `{scene}`: parameter `{key}` = {:?}: {why}", p.float(key)));
@@ -124,7 +186,7 @@ pub fn solid_setup(
     if !(0.5..=3.0).contains(&hdx) {
         return bad("hdx", "must lie in [0.5, 3]: the kernel must reach the nearest particles");
     }
-    let mut material = SolidMaterial::new(p.float("youngs_modulus"), nu, p.float("density"))
+    let mut material = SolidMaterial::new(p.float("youngs_modulus"), nu, p.float(k.density))
         .map_err(|e| format!("scene `{scene}`: {e}"))?;
     if p.0.contains_key("yield_stress") {
         material = material
@@ -140,17 +202,18 @@ pub fn solid_setup(
     let steps = p.float("tf") / dt;
     if steps.is_nan() || steps > MAX_STEPS {
         return Err(format!(
-            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `density`, |u| = {u_max:.3e} m/s from {u_keys}, h = `hdx` `dx`: more than {MAX_STEPS:e}",
+            "scene `{scene}`: `tf` = {:?} needs {steps:.3e} steps of eq. (62), dt = `cfl` h / (c0 + |u|) = {dt:.3e} s with c0 = {:.3e} m/s from `youngs_modulus`, `poisson_ratio` and `{}`, |u| = {u_max:.3e} m/s from {u_keys}, h = `hdx` `dx`: more than {MAX_STEPS:e}",
             p.float("tf"),
-            material.c0()
+            material.c0(),
+            k.density
         ));
     }
-    let pst = Pst::from_name(p.str("pst")).expect("checked choice");
-    let name = SolidSchemeName::from_name(p.str("scheme")).expect("checked choice");
+    let pst = Pst::from_name(p.str(k.pst)).expect("checked choice");
+    let name = SolidSchemeName::from_name(p.str(k.scheme)).expect("checked choice");
     let settings = SolidSettings {
         pst,
-        corrections: p.str("corrections") == "all",
-        alpha: p.float("alpha"),
+        corrections: p.str(k.corrections) == "all",
+        alpha: p.float(k.alpha),
         u_ref,
         w_dx: kernel.w(dx, h),
         gravity,

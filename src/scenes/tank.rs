@@ -84,10 +84,23 @@ impl Column {
         physics: FluidScheme,
         g: f64,
     ) -> Result<(Fluid<2>, Wall<2>), String> {
+        self.bodies_without(p, (h, c0, physics, g), |_| false)
+    }
+
+    /// As [`bodies`](Self::bodies), without the wall particles where `removed` (where a
+    /// structure takes the wall's place: a plate as the tank's floor, a clamp through it).
+    pub fn bodies_without(
+        &self,
+        p: &Params,
+        (h, c0, physics, g): (f64, f64, FluidScheme, f64),
+        removed: impl Fn(&Vector<2>) -> bool,
+    ) -> Result<(Fluid<2>, Wall<2>), String> {
         let Self { width, height, tank: (tw, th), dx } = *self;
         let hydrostatic = |x: &Vector<2>| RHO0 * g * (height - x[1]);
         let fluid = fluid_at_rest(lattice(0.0, width, 0.0, height, dx), dx, RHO0, h, physics, hydrostatic)?;
-        let wall = wall_from(&box_walls(tw, th, dx, LAYERS, false), |_| Vector::zeros(), dx, RHO0, c0)?
+        let mut walls = box_walls(tw, th, dx, LAYERS, false);
+        walls.retain(|(x, _)| !removed(x));
+        let wall = wall_from(&walls, |_| Vector::zeros(), dx, RHO0, c0)?
             .with_models(wall_density(p), wall_pressure(p), wall_viscosity(p));
         Ok((fluid, wall))
     }

@@ -1110,15 +1110,20 @@ impl<const D: usize> Simulation<D> {
         let in_fluid = &self.couplings.in_fluid;
         for (c, passes) in self.couplings.solids.iter_mut().filter(|(c, _)| in_fluid[c.body]) {
             let st = &mut self.state;
+            // The sub-steps bin the structure in a box around it, not in the whole domain:
+            // binning clears every cell of its grid, and a structure is small in its tank.
+            let mut local = (n > 1 && !domain.periodic.iter().any(|&p| p))
+                .then(|| structure_cells(st.bodies[c.body].x(), self.bins[c.body].radius()));
             for _ in 0..n {
                 st.bodies[c.body].kick_open(&st.rates[c.body], dt_s);
                 solid_update(c, passes, st, dt_s);
                 let Body::ElasticSolid(solid) = &mut st.bodies[c.body] else { unreachable!("a solid") };
                 solid.drift(dt_s);
                 solid.x.iter_mut().for_each(|x| domain.wrap(x));
-                self.bins[c.body].update(&solid.x);
-                c.relist(&self.bins[c.body], solid, kernel);
-                solid_passes(c, passes, st, (&self.bins[c.body], kernel), dt_s, next_step);
+                let cells = local.as_mut().unwrap_or(&mut self.bins[c.body]);
+                cells.update(&solid.x);
+                c.relist(cells, solid, kernel);
+                solid_passes(c, passes, st, (cells, kernel), dt_s, next_step);
                 st.bodies[c.body].kick_close(&st.rates[c.body], dt_s);
             }
         }
@@ -1220,6 +1225,19 @@ fn solid_passes<const D: usize>(
     let SolidRates { du, a_fsi, .. } = rates;
     du.iter_mut().zip(a_fsi.iter()).for_each(|(du, a)| *du += a);
     solid::homogenise(passes, solid, &c.list, cells, kernel, rates, dt, next_step);
+}
+
+/// A cell list of search radius `radius` over the box around the points `x` with a margin
+/// of four radii: a structure's binning within one fluid step, over which it moves far
+/// less (points that did leave the box would be binned in its edge cells, still found).
+fn structure_cells<const D: usize>(x: &[Vector<D>], radius: f64) -> CellList<D> {
+    let (mut lo, mut hi) = ([f64::INFINITY; D], [f64::NEG_INFINITY; D]);
+    for p in x {
+        for k in 0..D {
+            (lo[k], hi[k]) = (lo[k].min(p[k] - 4.0 * radius), hi[k].max(p[k] + 4.0 * radius));
+        }
+    }
+    CellList::new(Domain::bounded(lo, hi), radius)
 }
 
 /// The tuner of `tuners` for the current pool's number of threads, added on first use.

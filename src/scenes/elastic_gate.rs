@@ -1,0 +1,214 @@
+//! Water released through an elastic gate (Antoci, Gallati & Sibilla 2007, "Numerical
+//! simulation of fluid-structure interaction by SPH", Computers & Structures 85): beyond the
+//! thesis, the FSI benchmark SPH codes validate against. Water `column_width` = 0.1 m wide
+//! and `column_height` = 0.14 m high at the left of a tank is held by a rubber gate
+//! `gate_thickness` = 0.005 m thick and `gate_length` = 0.079 m long standing on the floor
+//! to the water's right, clamped at its top to a rigid wall that holds the water above it
+//! and free at its lower end; the floor runs on beyond the gate to the tank's far wall at
+//! `tank_width` = 0.5 m. The gate's material is that of the CTVF authors' reproduction
+//! (github.com/dineshadepu/fsi_etvf, `ng_2020_elastic_dam_break.py`, after Ng et al. 2020
+//! and Antoci et al. 2007): rho = 1100 kg/m^3, E = 11.96 MPa (a shear modulus of 4.27 MPa
+//! at nu = 0.4), nu = 0.4. The fluid is the CTVF fluid of the dam break (EDAC pressure,
+//! continuity density, Sun shifting, artificial viscosity `alpha` = 0.05 as that script
+//! runs it), c0 = 10 sqrt(2 g H); the gate the CTVF solid with IPST, under gravity,
+//! stepping `solid_substeps` times per fluid step (its sound speed, 135 m/s, is about eight
+//! times the water's).
+//!
+//! The gate is a lattice of `round(gate_thickness / dx)` x `round(gate_length / dx)`
+//! particles from the floor up; the rigid wall above it is fixed particles of the same body
+//! continuing its columns up to the tank's top (its clamp and the wall the water leans on
+//! above the gate).
+//!
+//! `tip_x`, `tip_y`: the displacement of the gate's free end (the mean of its lowest row)
+//! from its start (m). Metrics: `tip_x_max`, `tip_y_max` (m), the largest over the run;
+//! `tip_x_rms`, `tip_y_rms`, the RMS deviation from Antoci et al.'s measured free-end
+//! displacements at their times within the run (m); `particles_lost`, water particles
+//! beyond the outer layer of the tank's walls or inside the gate, at the end or at any sample
+//! before it.
+//! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
+
+use super::common::{
+    forward_to_sim, free_surface_params, plan, restore_sim, rms_deviation, scheme_params, snapshot_bodies,
+    surface_fields, wall_params,
+};
+use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, reference_curve, structure_params, FsiSetup, Probe};
+use super::geometry::lattice;
+use super::params::{Bound, Params, Spec};
+use super::solid_common::SolidDefaults;
+use super::tank::{Column, G, LAYERS};
+use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::nnps::Domain;
+use crate::solver::simulation::Simulation;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+const ANTOCI: &str = include_str!("../../reference_data/antoci2007_gate_tip_displacement.csv");
+
+/// The gate's body name.
+const GATE: &str = "gate";
+
+/// The registry entry.
+pub const ENTRY: SceneEntry = SceneEntry {
+    name: "elastic_gate",
+    dim: 2,
+    about: "Water released through an elastic rubber gate (Antoci, Gallati & Sibilla 2007)",
+    params,
+    build,
+    check: |p| setup(p).map(drop),
+    metrics: &["tip_x_max", "tip_y_max", "tip_x_rms", "tip_y_rms", "particles_lost"],
+    columns: &["t", "tip_x", "tip_y", "max_speed"],
+    outputs: 0,
+};
+
+fn params() -> Vec<Spec> {
+    let mut v = vec![
+        Spec::float("dx", 0.001, Bound::Positive, "particle spacing of water and gate (m)"),
+        Spec::float("column_width", 0.1, Bound::Positive, "water column width (m), from the left wall to the gate"),
+        Spec::float("column_height", 0.14, Bound::Positive, "water column height H (m)"),
+        Spec::float("gate_thickness", 0.005, Bound::Positive, "gate thickness (m)"),
+        Spec::float("gate_length", 0.079, Bound::Positive, "gate length from the floor to its clamp (m)"),
+        Spec::float("tank_width", 0.5, Bound::Positive, "tank width (m): the floor beyond the gate"),
+        Spec::float("tank_height", 0.16, Bound::Positive, "tank wall height (m), the rigid wall above the gate's too"),
+        Spec::float("alpha", 0.05, Bound::NonNegative, "the water's artificial viscosity alpha, eq. (28)"),
+    ];
+    v.extend(scheme_params("sun"));
+    v.extend(free_surface_params());
+    v.extend(wall_params());
+    v.extend(structure_params(&SolidDefaults {
+        dx: 0.001,
+        youngs_modulus: 11.958923292360354e6,
+        poisson_ratio: 0.4,
+        density: 1100.0,
+        yield_stress: None,
+        alpha: 1.0,
+        pst: "ipst",
+    }));
+    v.extend(common_params(0.4));
+    v
+}
+
+fn column(p: &Params) -> Column {
+    let tank = (p.float("tank_width"), p.float("tank_height"));
+    Column { width: p.float("column_width"), height: p.float("column_height"), tank, dx: p.float("dx") }
+}
+
+const KEYS: [&str; 4] = ["column_width", "column_height", "tank_width", "tank_height"];
+
+fn setup(p: &Params) -> Result<FsiSetup, String> {
+    let scene = "elastic_gate";
+    let bad = |key: &str, why: String| Err(format!("scene `{scene}`: `{key}` = {}: {why}", p.float(key)));
+    let (l, hc) = (p.float("column_width"), p.float("column_height"));
+    let (t, gl) = (p.float("gate_thickness"), p.float("gate_length"));
+    let (tw, th, dx) = (p.float("tank_width"), p.float("tank_height"), p.float("dx"));
+    if l + t > tw {
+        return bad("gate_thickness", format!("the gate (x from {l} to {}) reaches beyond the tank (tank_width = {tw})", l + t));
+    }
+    if th < hc {
+        return bad("tank_height", format!("the tank is lower than the column (column_height = {hc})"));
+    }
+    if gl >= hc {
+        return bad("gate_length", format!("the gate is as high as the water (column_height = {hc}): nothing holds it above"));
+    }
+    if t < 2.0 * dx {
+        return bad("gate_thickness", format!("the gate needs at least two particles across (dx = {dx})"));
+    }
+    // The free end swings at most at the water's outflow speed, sqrt(2 g H).
+    let u = (2.0 * G * hc).sqrt();
+    fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)
+}
+
+struct Gate {
+    sim: Simulation<2>,
+    tip: Probe,
+    /// (t, tip_x, tip_y) samples.
+    samples: Vec<(f64, f64, f64)>,
+    /// Water particles found outside the tank or inside the gate at the samples so far.
+    lost_max: usize,
+    /// Tank width, spacing.
+    tank: (f64, f64),
+}
+
+fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
+    Ok(Box::new(gate(p)?))
+}
+
+fn gate(p: &Params) -> Result<Gate, String> {
+    let s = setup(p)?;
+    let (dx, l, t, gl) = (p.float("dx"), p.float("column_width"), p.float("gate_thickness"), p.float("gate_length"));
+    let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
+    let (fluid, wall) = column(p).bodies(p, s.h, s.constants.c0, s.fluid, G)?;
+    let free = lattice(l, l + t, 0.0, gl, dx);
+    let fixed = lattice(l, l + t, gl, th, dx);
+    let what = format!("`dx` = {dx} (`gate_thickness` = {t}, `tank_height` = {th})");
+    let gate = s.structure(("elastic_gate", &what), GATE, free, fixed, p)?;
+    let tip = Probe::new(&gate, "the gate's free end", |x| x[1] < dx)?;
+    let edge = (LAYERS as f64 + 1.0) * dx;
+    let domain = Domain::bounded([-edge, -edge], [tw + edge, th + 4.0 * p.float("column_height")]);
+    let sim = s.simulation("elastic_gate", p, domain, [fluid.into(), wall.into(), gate.into()])?;
+    Ok(Gate { sim, tip, samples: Vec::new(), lost_max: 0, tank: (tw, dx) })
+}
+
+/// Antoci et al.'s measured free-end displacement, component `x` or `y`.
+fn measured(component: &str) -> Vec<(f64, f64)> {
+    reference_curve(ANTOCI, (1, component), (2, 3))
+}
+
+impl Gate {
+    fn lost(&self) -> usize {
+        let (tw, dx) = self.tank;
+        fluid_outside(&self.sim, tw, dx) + fluid_inside(&self.sim, GATE, dx)
+    }
+}
+
+impl SceneRun for Gate {
+    forward_to_sim!();
+    fn plan(&self) -> String {
+        let (_, n) = self.sim.step_sizes();
+        plan(&self.sim, &format!("{LAYERS} wall layers, open top; the gate clamped to a rigid wall above it; {n} gate steps per fluid step"))
+    }
+    fn sample(&mut self) -> Vec<(&'static str, f64)> {
+        let t = self.sim.time();
+        let d = self.tip.displacement(self.sim.solid(GATE).expect("the gate").0);
+        self.samples.push((t, d[0], d[1]));
+        self.lost_max = self.lost_max.max(self.lost());
+        vec![("t", t), ("tip_x", d[0]), ("tip_y", d[1]), ("max_speed", self.sim.max_speed())]
+    }
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
+        snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
+    }
+    fn metrics(&self) -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost()) as f64)]);
+        for (k, component) in [(1, "x"), (2, "y")] {
+            let ours: Vec<(f64, f64)> = self.samples.iter().map(|s| (s.0, if k == 1 { s.1 } else { s.2 })).collect();
+            if let Some(max) = ours.iter().map(|s| s.1).reduce(f64::max) {
+                m.insert(format!("tip_{component}_max"), max);
+            }
+            if let Some(r) = rms_deviation(&ours, &measured(component)) {
+                m.insert(format!("tip_{component}_rms"), r);
+            }
+        }
+        m
+    }
+    fn save_state(&self) -> serde_json::Value {
+        serde_json::json!({ "sim": &self.sim.state, "samples": &self.samples, "lost_max": self.lost_max })
+    }
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
+        let bad = |e: serde_json::Error| format!("checkpoint: {e}");
+        self.samples = serde_json::from_value(state["samples"].clone()).map_err(bad)?;
+        self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
+        restore_sim(&mut self.sim, &state)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_measured_curves_parse() {
+        let (x, y) = (measured("x"), measured("y"));
+        assert_eq!((x.len(), y.len()), (9, 10));
+        assert!(x.iter().map(|s| s.1).fold(0.0, f64::max) > 0.04);
+        assert!(y.iter().map(|s| s.1).fold(0.0, f64::max) > 0.01);
+    }
+}

@@ -1,0 +1,213 @@
+//! What the fluid-structure scenes share (thesis ch. 4): a water column in a tank of wall
+//! particles (as [`tank`](super::tank) makes it, the fluid's scheme with the plain
+//! parameter names) meeting an elastic structure (its scheme with the names of
+//! [`STRUCTURE`]: `solid_scheme`, `solid_pst`, `solid_corrections`, `solid_alpha`,
+//! `solid_density`, and `youngs_modulus`, `poisson_ratio`), the structure stepping
+//! `solid_substeps` times per fluid step ([`Substeps`]); the structure presents itself to
+//! the fluid with the walls' models (`wall_density`, `wall_pressure`, `wall_viscosity`);
+//! and the checks that the fluid stays out of it.
+
+use super::common::{time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants};
+use super::params::{Params, Spec};
+use super::solid_common::{check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE};
+use super::tank::{Column, RHO0};
+use crate::solver::kernel::Kernel;
+use crate::solver::math::Vector;
+use crate::solver::nnps::Domain;
+use crate::solver::scheme::FluidScheme;
+use crate::solver::simulation::{Simulation, Substeps, TimeSettings};
+use crate::solver::systems::{Body, BoundaryMaterial, ElasticSolid, SolidInit};
+
+/// The parameters of a structure in a fluid with defaults `d` (the fluid's and the common
+/// ones come from the scene): its material and scheme, and its sub-steps.
+pub fn structure_params(d: &SolidDefaults) -> Vec<Spec> {
+    let mut v = solid_params_as(d, &STRUCTURE);
+    v.push(Spec::auto_or_int(
+        "solid_substeps",
+        1,
+        "steps of the structure per step of the fluid, the fluid's force held over them: auto (the ratio of the two time-step limits, eqs. 61-62, rounded up) or a number (1: no sub-steps, both at the smaller limit)",
+    ));
+    v
+}
+
+/// The sub-steps `p` asks for.
+pub fn substeps(p: &Params) -> Substeps {
+    match p.auto_or_int("solid_substeps") {
+        None => Substeps::Auto,
+        Some(n) => Substeps::Fixed(n as u32),
+    }
+}
+
+/// What a fluid-structure scene's parameters make, once every check that needs no particle
+/// has passed.
+pub struct FsiSetup {
+    /// The fluid's constants (c0 = 10 sqrt(2 g H) of the column).
+    pub constants: FluidConstants,
+    /// The kernel, shared by both bodies.
+    pub kernel: Kernel,
+    /// The fluid's smoothing length (the structure's too: one spacing, one `hdx`).
+    pub h: f64,
+    /// The fluid's scheme.
+    pub fluid: FluidScheme,
+    /// The structure's material and scheme.
+    pub solid: SolidSetup,
+    /// The structure's steps per fluid step.
+    pub substeps: Substeps,
+}
+
+/// The setup of scene `scene`: the column's (`keys` as [`Column::setup`] takes them), and
+/// the structure's (the largest speed it is expected to reach, `u_max`, and the keys that
+/// set it; gravity `g` on it, m/s^2 downward). The kernel must be the solid's (the quintic
+/// spline): one kernel serves both bodies.
+pub fn fsi_setup(
+    scene: &str,
+    p: &Params,
+    (column, keys): (&Column, [&str; 4]),
+    u_max: (f64, &str),
+    g: f64,
+) -> Result<FsiSetup, String> {
+    let (constants, kernel, h, fluid) = column.setup(scene, keys, p)?;
+    let solid = solid_setup_as(scene, p, &STRUCTURE, u_max, (constants.u_ref, [0.0, -g, 0.0]))?;
+    if kernel.kind() != solid.kernel.kind() {
+        return Err(format!(
+            "scene `{scene}`: `kernel` = {}: the structure's solid takes the quintic spline, and one kernel serves both bodies",
+            p.str("kernel")
+        ));
+    }
+    Ok(FsiSetup { constants, kernel, h, fluid, solid, substeps: substeps(p) })
+}
+
+impl FsiSetup {
+    /// The structure `name` of free particles `free` and fixed ones `fixed` (its clamps, at
+    /// rest) at the setup's spacing, refused by its particle count first (`what` names the
+    /// parameters it comes from); it presents itself to the fluid with the walls' models
+    /// and the fluid's density and sound speed.
+    pub fn structure(
+        &self,
+        (scene, what): (&str, &str),
+        name: &str,
+        free: Vec<Vector<2>>,
+        fixed: Vec<Vector<2>>,
+        p: &Params,
+    ) -> Result<ElasticSolid<2>, String> {
+        check_count(scene, what, (free.len() + fixed.len()) as f64)?;
+        let s = &self.solid;
+        let n = free.len() + fixed.len();
+        let mut flags = vec![false; free.len()];
+        flags.resize(n, true);
+        let mut x = free;
+        x.extend(fixed);
+        let rho0 = s.material.rho0;
+        let init =
+            SolidInit { x, u: vec![Vector::zeros(); n], m: vec![rho0 * s.dx * s.dx; n], rho: vec![rho0; n], fixed: flags };
+        let boundary = BoundaryMaterial {
+            rho0: RHO0,
+            c0: self.constants.c0,
+            density: wall_density(p),
+            pressure: wall_pressure(p),
+            viscosity: wall_viscosity(p),
+        };
+        ElasticSolid::new(name, s.h, init, s.material, s.scheme)
+            .and_then(|solid| solid.facing_fluid(boundary))
+            .map_err(|e| format!("scene `{scene}`: {e}"))
+    }
+
+    /// The simulation of `bodies` in `domain`, its time loop as the common parameters set it
+    /// with the structure's sub-steps.
+    pub fn simulation(
+        &self,
+        scene: &str,
+        p: &Params,
+        domain: Domain<2>,
+        bodies: impl IntoIterator<Item = Body<2>>,
+    ) -> Result<Simulation<2>, String> {
+        let time = TimeSettings { solid_substeps: self.substeps, ..time_settings(p) };
+        let builder = Simulation::builder(domain, self.kernel).time(time);
+        bodies
+            .into_iter()
+            .fold(builder, |b, body| b.body(body))
+            .build()
+            .map_err(|e| format!("scene `{scene}`: {e}"))
+    }
+}
+
+/// Fluid particles of `sim` inside the structure `name` (particle spacing `dx`): those with
+/// at least four of its particles within 1.55 dx, around them on every side (the mean of
+/// the unit vectors towards them shorter than one half). A fluid particle against the
+/// structure's surface has at most three there, all on one side; one in a corner between
+/// the structure and its clamp has them within a quarter of the circle (a mean of 0.6 or
+/// more); one inside has the lattice around it.
+pub fn fluid_inside(sim: &Simulation<2>, name: &str, dx: f64) -> usize {
+    let Some((s, _)) = sim.solid(name) else { return 0 };
+    let r2 = (1.55 * dx) * (1.55 * dx);
+    let (lo, hi) = s.x.iter().fold(
+        (Vector::<2>::repeat(f64::INFINITY), Vector::<2>::repeat(f64::NEG_INFINITY)),
+        |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+    );
+    let near_box = |x: &Vector<2>| (0..2).all(|k| x[k] > lo[k] - 2.0 * dx && x[k] < hi[k] + 2.0 * dx);
+    let surrounded = |x: &Vector<2>| {
+        let (n, sum) = s.x.iter().map(|y| y - x).filter(|d| d.norm_squared() < r2).fold(
+            (0usize, Vector::<2>::zeros()),
+            |(n, sum), d| (n + 1, sum + d / d.norm().max(1e-300)),
+        );
+        n >= 4 && sum.norm() < 0.5 * n as f64
+    };
+    sim.fluid().x.iter().filter(|x| near_box(x) && surrounded(x)).count()
+}
+
+/// Fluid particles of `sim` that left a tank `tank_width` wide with its floor at y = 0
+/// (spacing `dx`): beyond the outer layer of its side walls or its floor. A particle within
+/// the layers has penetrated a wall, not left.
+pub fn fluid_outside(sim: &Simulation<2>, tank_width: f64, dx: f64) -> usize {
+    let depth = super::tank::LAYERS as f64 * dx;
+    sim.fluid().x.iter().filter(|x| x[0] < -depth || x[0] > tank_width + depth || x[1] < -depth).count()
+}
+
+/// A point of a structure followed over a run: the mean position of some of its particles,
+/// and its displacement from where it started.
+#[derive(Clone, Debug)]
+pub struct Probe {
+    indices: Vec<usize>,
+    start: Vector<2>,
+}
+
+impl Probe {
+    /// The mean of the free particles of `solid` at which `pick` holds (`what` names them in
+    /// the error when there are none).
+    pub fn new(solid: &ElasticSolid<2>, what: &str, pick: impl Fn(&Vector<2>) -> bool) -> Result<Self, String> {
+        let indices: Vec<usize> = (0..solid.len()).filter(|&i| !solid.fixed[i] && pick(&solid.x[i])).collect();
+        if indices.is_empty() {
+            return Err(format!("solid `{}`: no particle at {what}", solid.name));
+        }
+        let mut probe = Self { indices, start: Vector::zeros() };
+        probe.start = probe.position(solid);
+        Ok(probe)
+    }
+
+    /// The mean position of the particles now.
+    pub fn position(&self, solid: &ElasticSolid<2>) -> Vector<2> {
+        self.indices.iter().map(|&i| solid.x[i]).sum::<Vector<2>>() / self.indices.len() as f64
+    }
+
+    /// The displacement from the start.
+    pub fn displacement(&self, solid: &ElasticSolid<2>) -> Vector<2> {
+        self.position(solid) - self.start
+    }
+}
+
+/// The points `(t, value)` of the CSV `text` (a header row, then rows) whose column
+/// `source` equals `which`, with `t` and the value in the columns `t` and `value`, in time
+/// order.
+pub fn reference_curve(text: &str, (key, which): (usize, &str), (t, value): (usize, usize)) -> Vec<(f64, f64)> {
+    let mut out: Vec<(f64, f64)> = text
+        .lines()
+        .skip(1)
+        .filter_map(|l| {
+            let c: Vec<&str> = l.split(',').map(str::trim).collect();
+            (c.get(key)? == &which).then_some(())?;
+            Some((c.get(t)?.parse().ok()?, c.get(value)?.parse().ok()?))
+        })
+        .collect();
+    out.sort_by(|a, b| a.0.total_cmp(&b.0));
+    out
+}
