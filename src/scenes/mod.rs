@@ -4,6 +4,7 @@
 //! [`SCENES`].
 
 pub mod cavity;
+pub mod clamped_beam_udl;
 pub mod colliding_rings;
 pub mod common;
 pub mod dam_break;
@@ -109,6 +110,7 @@ pub const SCENES: &[SceneEntry] = &[
     colliding_rings::ENTRY,
     high_velocity_impact::ENTRY,
     turek_csm3::ENTRY,
+    clamped_beam_udl::ENTRY,
     hydrostatic_plate::ENTRY,
     dam_break_elastic_plate::ENTRY,
     elastic_gate::ENTRY,
@@ -194,6 +196,7 @@ mod tests {
             ("colliding_rings", &["separation=0.05"]),
             ("colliding_rings", &["dx=0.02"]),
             ("turek_csm3", &["dx=0.02"]),
+            ("clamped_beam_udl", &["dx=0.005"]),
         ];
         for (scene, sets) in cases {
             let e = find(scene).unwrap();
@@ -219,6 +222,7 @@ mod tests {
                 "oscillating_plate" => vec!["dx=0.01"],
                 "colliding_rings" => vec!["dx=0.004"],
                 "turek_csm3" => vec!["dx=0.005"],
+                "clamped_beam_udl" => vec!["dx=0.003"],
                 _ => vec![],
             };
             for pst in ["sun", "none"] {

@@ -44,14 +44,13 @@
 use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
+    check_count, forward_stepwise, solid_params, solid_setup, Extrema, SolidDefaults, SolidSetup,
 };
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::simulation::Simulation;
 use crate::solver::systems::{ElasticSolid, SolidInit};
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -143,66 +142,6 @@ fn setup(p: &Params) -> Result<Setup, String> {
     check_count(scene, &flag, nxf * nyf)?;
     let layers = solid.support_layers();
     Ok(Setup { solid, nx: nxf as usize, ny: nyf as usize, layers })
-}
-
-/// Troughs and peaks of a signal followed step by step, with a hysteresis (module docs).
-#[derive(Clone, Debug, Default, Serialize, Deserialize)]
-pub struct Extrema {
-    /// The hysteresis (m).
-    pub delta: f64,
-    /// Seeking a peak (after a trough) rather than a trough.
-    pub rising: bool,
-    /// The running extremum (t, y) since the last confirmed one.
-    pub run: Option<(f64, f64)>,
-    /// Confirmed troughs, (t, y).
-    pub troughs: Vec<(f64, f64)>,
-    /// Confirmed peaks, (t, y).
-    pub peaks: Vec<(f64, f64)>,
-}
-
-impl Extrema {
-    /// A detector that seeks a trough first (a flag released from rest falls).
-    pub fn new(delta: f64) -> Self {
-        Self { delta, ..Self::default() }
-    }
-
-    /// Takes the value `y` at time `t`.
-    pub fn push(&mut self, t: f64, y: f64) {
-        let (tr, yr) = *self.run.get_or_insert((t, y));
-        if self.rising {
-            if y > yr {
-                self.run = Some((t, y));
-            } else if y < yr - self.delta {
-                self.peaks.push((tr, yr));
-                self.rising = false;
-                self.run = Some((t, y));
-            }
-        } else if y < yr {
-            self.run = Some((t, y));
-        } else if y > yr + self.delta {
-            self.troughs.push((tr, yr));
-            self.rising = true;
-            self.run = Some((t, y));
-        }
-    }
-
-    /// The last complete period: (mean, amplitude, frequency) from the last two troughs and
-    /// the peak between them (module docs), if there are two troughs.
-    pub fn last_period(&self) -> Option<(f64, f64, f64)> {
-        let k = self.troughs.len();
-        if k < 2 {
-            return None;
-        }
-        let ((t1, y1), (t2, y2)) = (self.troughs[k - 2], self.troughs[k - 1]);
-        let peak = self
-            .peaks
-            .iter()
-            .filter(|(t, _)| *t > t1 && *t < t2)
-            .map(|p| p.1)
-            .fold(f64::NEG_INFINITY, f64::max);
-        let low = y1.min(y2);
-        Some((0.5 * (peak + low), 0.5 * (peak - low), 1.0 / (t2 - t1)))
-    }
 }
 
 struct Flag {
@@ -325,25 +264,6 @@ impl SceneRun for Flag {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The extremum detector on a noisy cosine `y = -A (1 - cos 2 pi f t) + noise`: the
-    /// last period gives mean -A, amplitude A and frequency f to within the noise (1e-3 A,
-    /// far below the hysteresis of 0.1 A, which the noise must not trigger).
-    #[test]
-    fn the_extremum_detector_reads_a_noisy_oscillation() {
-        let (a, f) = (0.065, 1.1);
-        let mut e = Extrema::new(0.1 * a);
-        for k in 0..40_000 {
-            let t = k as f64 * 1e-4;
-            let noise = 1e-3 * a * (k as f64 * 1.7).sin();
-            e.push(t, -a * (1.0 - (2.0 * std::f64::consts::PI * f * t).cos()) + noise);
-        }
-        let (mean, amp, freq) = e.last_period().unwrap();
-        assert!((mean + a).abs() < 2e-3 * a, "{mean}");
-        assert!((amp - a).abs() < 2e-3 * a, "{amp}");
-        assert!((freq - f).abs() < 1e-3 * f, "{freq}");
-        assert_eq!(e.troughs.len(), 4, "{:?}", e.troughs);
-    }
 
     /// The quick flag (dx = 0.005, four particles across) through 2 s: the tip sags and
     /// swings. Its mean sag within a factor of two of the published CSM3 value (a flag

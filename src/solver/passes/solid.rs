@@ -79,7 +79,8 @@ pub fn density_and_stress_rates<const D: usize>(
 }
 
 /// The accelerations of `solid` (eq. 30 with Monaghan's artificial viscosity, eq. 28,
-/// Monaghan's artificial stress if the scheme has it, and the body force) over its list `nl` into `rates.du`, and Sun's shifting (eq. 36, for a
+/// Monaghan's artificial stress if the scheme has it, the body force and the scheme's
+/// external load on its particle range) over its list `nl` into `rates.du`, and Sun's shifting (eq. 36, for a
 /// step `dt`) into `rates.a_c`, after detecting the free surface (sec. 3.4) if the scheme
 /// asks, with the shifting zero on it and tangential next to it (eq. 44). Fixed particles
 /// get zero of both.
@@ -107,6 +108,7 @@ pub fn accelerations<const D: usize>(
     let sun_prefactor = s.shifting.map_or(0.0, |sh| -sh.ma_c0 * 2.0 * h / dt);
     rates.a_c_dt = s.transports().then_some(dt);
     let gravity = s.gravity_vector::<D>();
+    let load = s.load;
     let surface = passes.surface.as_ref().filter(|_| s.free_surface);
     let fixed = &solid.fixed;
     let rate = |i: usize| -> (Vector<D>, Vector<D>) {
@@ -120,7 +122,8 @@ pub fn accelerations<const D: usize>(
         if let Some(fs) = surface {
             ac = adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
         }
-        (sums.acc + gravity, ac)
+        let external = load.map_or(Vector::zeros(), |l| l.on::<D>(i));
+        (sums.acc + gravity + external, ac)
     };
     // Without Sun's shifting the homogenisation is IPST's, or none: only du here.
     if s.shifting.is_none() {
@@ -177,7 +180,7 @@ mod tests {
     use crate::solver::kernel::{Kernel, KernelKind};
     use crate::solver::math::Vector;
     use crate::solver::nnps::Domain;
-    use crate::solver::scheme::{Pst, SolidSchemeName, SolidSettings};
+    use crate::solver::scheme::{ParticleLoad, Pst, SolidSchemeName, SolidSettings};
     use crate::solver::simulation::Simulation;
     use crate::solver::systems::{ElasticSolid, SolidInit, SolidMaterial};
 
@@ -244,6 +247,41 @@ mod tests {
                 assert!(moved < 0.01 * dx, "moved {moved:e}");
                 assert!(stress < 1e-6 * k && p < 1e-6 * k, "sqrt(3 J2) = {stress:e}, |p| = {p:e}");
             }
+        }
+    }
+
+    /// The scheme's external load accelerates the particles of its range and no other, by
+    /// exactly its acceleration: ten particles farther apart than the kernel's support (no
+    /// neighbours, so no stress and no density change), no shifting, no viscosity; the load
+    /// on particles 3..7, one of them fixed. After 100 steps the loaded free particles move
+    /// at `a t` and the others, and the fixed one, are at rest (to rounding: 1e-12 a t).
+    #[test]
+    fn an_external_load_acts_on_its_range_only() {
+        let dx = 0.01;
+        let mut init = SolidInit::<2>::default();
+        for k in 0..10 {
+            init.x.push(Vector::<2>::new(5.0 * dx * k as f64, 0.0));
+            init.u.push(Vector::zeros());
+            init.m.push(material().rho0 * dx * dx);
+            init.rho.push(material().rho0);
+            init.fixed.push(k == 5);
+        }
+        let mut body = solid(init, dx, Pst::None, 0.0);
+        let a = [0.0, -2.5, 0.0];
+        body.physics.load = Some(ParticleLoad { accel: a, first: 3, end: 7 });
+        let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+        let domain = Domain::bounded([-1.0, -1.0], [1.0, 1.0]);
+        let mut sim = Simulation::builder(domain, kernel).body(body).build().unwrap();
+        for _ in 0..100 {
+            sim.step(f64::INFINITY).unwrap();
+        }
+        let (t, s) = (sim.time(), sim.solids().next().unwrap());
+        for (k, u) in s.u.iter().enumerate() {
+            let expected = if (3..7).contains(&k) && k != 5 { a[1] * t } else { 0.0 };
+            assert!(
+                (u[1] - expected).abs() <= 1e-12 * (a[1] * t).abs() && u[0] == 0.0,
+                "particle {k}: {u:?}"
+            );
         }
     }
 
