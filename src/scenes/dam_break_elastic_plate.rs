@@ -20,14 +20,15 @@
 //! from its start (m). Metrics: `tip_x_max`, the largest `tip_x` over the run (m);
 //! `tip_x_rms`, the RMS deviation of `tip_x` from Sun et al.'s (2019) MPS-DEM curve at its
 //! times within the run (m); `tip_x_rms_bogaers`, the same against Bogaers et al.'s (2016)
-//! QN-LS curve; `particles_lost`, water particles beyond the outer layer of the tank's walls or inside the plate, at the end or at any sample before it.
+//! QN-LS curve; `clusters_max`, `max_gap`, the plate's numerical fracture (particles linked
+//! within 1.5 dx; 1 cluster: intact); `particles_lost`, water particles beyond the outer layer of the tank's walls or inside the plate, at the end or at any sample before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
 use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, rms_deviation, scheme_params, snapshot_bodies,
-    surface_fields, wall_params,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
+    wall_params,
 };
-use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, reference_curve, structure_params, FsiSetup, Probe};
+use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::SolidDefaults;
@@ -52,7 +53,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     check: |p| setup(p).map(drop),
-    metrics: &["tip_x_max", "tip_x_rms", "tip_x_rms_bogaers", "particles_lost"],
+    metrics: &["tip_x_max", "tip_x_rms", "tip_x_rms_bogaers", "particles_lost", "clusters_max"],
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
@@ -128,13 +129,7 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
 
 struct PlateImpact {
     sim: Simulation<2>,
-    tip: Probe,
-    /// (t, tip_x) samples.
-    samples: Vec<(f64, f64)>,
-    /// Water particles found outside the tank or inside the plate at the samples so far.
-    lost_max: usize,
-    /// Tank width, spacing.
-    tank: (f64, f64),
+    watch: Watch,
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
@@ -166,20 +161,13 @@ fn impact(p: &Params) -> Result<PlateImpact, String> {
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-tw, -edge - clamp], [2.0 * tw, th + 8.0 * p.float("column_height")]);
     let sim = s.simulation("dam_break_elastic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
-    Ok(PlateImpact { sim, tip, samples: Vec::new(), lost_max: 0, tank: (tw, dx) })
+    Ok(PlateImpact { sim, watch: Watch::new(PLATE, tip, (tw, dx)) })
 }
 
 /// Sun et al.'s (2019) MPS-DEM curve of the tip's x displacement, or another `source` of
 /// the reference file.
 fn published(source: &str) -> Vec<(f64, f64)> {
     reference_curve(SUN2019, (0, source), (1, 2))
-}
-
-impl PlateImpact {
-    fn lost(&self) -> usize {
-        let (tw, dx) = self.tank;
-        fluid_outside(&self.sim, tw, dx) + fluid_inside(&self.sim, PLATE, dx)
-    }
 }
 
 impl SceneRun for PlateImpact {
@@ -189,34 +177,23 @@ impl SceneRun for PlateImpact {
         plan(&self.sim, &format!("{LAYERS} wall layers, open top; the plate clamped through the floor; {n} plate steps per fluid step"))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
-        let t = self.sim.time();
-        let d = self.tip.displacement(self.sim.solid(PLATE).expect("the plate").0);
-        self.samples.push((t, d[0]));
-        self.lost_max = self.lost_max.max(self.lost());
-        vec![("t", t), ("tip_x", d[0]), ("tip_y", d[1]), ("max_speed", self.sim.max_speed())]
+        self.watch.sample(&self.sim)
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
-        let mut m = BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost()) as f64)]);
-        if let Some(max) = self.samples.iter().map(|s| s.1).reduce(f64::max) {
-            m.insert("tip_x_max".into(), max);
-        }
-        for (key, source) in [("tip_x_rms", "sun_2019_mps_dem"), ("tip_x_rms_bogaers", "bogaers_2016_qn_ls")] {
-            if let Some(r) = rms_deviation(&self.samples, &published(source)) {
-                m.insert(key.into(), r);
-            }
-        }
-        m
+        let published = [
+            ("tip_x_rms", 0, published("sun_2019_mps_dem")),
+            ("tip_x_rms_bogaers", 0, published("bogaers_2016_qn_ls")),
+        ];
+        self.watch.metrics(&self.sim, &published)
     }
     fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "samples": &self.samples, "lost_max": self.lost_max })
+        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let bad = |e: serde_json::Error| format!("checkpoint: {e}");
-        self.samples = serde_json::from_value(state["samples"].clone()).map_err(bad)?;
-        self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
+        self.watch.load(&state["watch"])?;
         restore_sim(&mut self.sim, &state)
     }
 }

@@ -22,16 +22,18 @@
 //! `tip_x`, `tip_y`: the displacement of the gate's free end (the mean of its lowest row)
 //! from its start (m). Metrics: `tip_x_max`, `tip_y_max` (m), the largest over the run;
 //! `tip_x_rms`, `tip_y_rms`, the RMS deviation from Antoci et al.'s measured free-end
-//! displacements at their times within the run (m); `particles_lost`, water particles
+//! displacements at their times within the run (m); `clusters_max`, `max_gap`, the gate's
+//! numerical fracture (particles linked within 1.5 dx; 1 cluster: intact); `particles_lost`,
+//! water particles
 //! beyond the outer layer of the tank's walls or inside the gate, at the end or at any sample
 //! before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
 use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, rms_deviation, scheme_params, snapshot_bodies,
-    surface_fields, wall_params,
+    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
+    wall_params,
 };
-use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, reference_curve, structure_params, FsiSetup, Probe};
+use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::SolidDefaults;
@@ -55,7 +57,7 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     check: |p| setup(p).map(drop),
-    metrics: &["tip_x_max", "tip_y_max", "tip_x_rms", "tip_y_rms", "particles_lost"],
+    metrics: &["tip_x_max", "tip_y_max", "tip_x_rms", "tip_y_rms", "particles_lost", "clusters_max"],
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
@@ -119,13 +121,7 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
 
 struct Gate {
     sim: Simulation<2>,
-    tip: Probe,
-    /// (t, tip_x, tip_y) samples.
-    samples: Vec<(f64, f64, f64)>,
-    /// Water particles found outside the tank or inside the gate at the samples so far.
-    lost_max: usize,
-    /// Tank width, spacing.
-    tank: (f64, f64),
+    watch: Watch,
 }
 
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
@@ -145,19 +141,12 @@ fn gate(p: &Params) -> Result<Gate, String> {
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-edge, -edge], [tw + edge, th + 4.0 * p.float("column_height")]);
     let sim = s.simulation("elastic_gate", p, domain, [fluid.into(), wall.into(), gate.into()])?;
-    Ok(Gate { sim, tip, samples: Vec::new(), lost_max: 0, tank: (tw, dx) })
+    Ok(Gate { sim, watch: Watch::new(GATE, tip, (tw, dx)) })
 }
 
 /// Antoci et al.'s measured free-end displacement, component `x` or `y`.
 fn measured(component: &str) -> Vec<(f64, f64)> {
     reference_curve(ANTOCI, (1, component), (2, 3))
-}
-
-impl Gate {
-    fn lost(&self) -> usize {
-        let (tw, dx) = self.tank;
-        fluid_outside(&self.sim, tw, dx) + fluid_inside(&self.sim, GATE, dx)
-    }
 }
 
 impl SceneRun for Gate {
@@ -167,35 +156,20 @@ impl SceneRun for Gate {
         plan(&self.sim, &format!("{LAYERS} wall layers, open top; the gate clamped to a rigid wall above it; {n} gate steps per fluid step"))
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
-        let t = self.sim.time();
-        let d = self.tip.displacement(self.sim.solid(GATE).expect("the gate").0);
-        self.samples.push((t, d[0], d[1]));
-        self.lost_max = self.lost_max.max(self.lost());
-        vec![("t", t), ("tip_x", d[0]), ("tip_y", d[1]), ("max_speed", self.sim.max_speed())]
+        self.watch.sample(&self.sim)
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
-        let mut m = BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost()) as f64)]);
-        for (k, component) in [(1, "x"), (2, "y")] {
-            let ours: Vec<(f64, f64)> = self.samples.iter().map(|s| (s.0, if k == 1 { s.1 } else { s.2 })).collect();
-            if let Some(max) = ours.iter().map(|s| s.1).reduce(f64::max) {
-                m.insert(format!("tip_{component}_max"), max);
-            }
-            if let Some(r) = rms_deviation(&ours, &measured(component)) {
-                m.insert(format!("tip_{component}_rms"), r);
-            }
-        }
-        m
+        let published = [("tip_x_rms", 0, measured("x")), ("tip_y_rms", 1, measured("y"))];
+        self.watch.metrics(&self.sim, &published)
     }
     fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "samples": &self.samples, "lost_max": self.lost_max })
+        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let bad = |e: serde_json::Error| format!("checkpoint: {e}");
-        self.samples = serde_json::from_value(state["samples"].clone()).map_err(bad)?;
-        self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
+        self.watch.load(&state["watch"])?;
         restore_sim(&mut self.sim, &state)
     }
 }

@@ -7,16 +7,18 @@
 //! the fluid with the walls' models (`wall_density`, `wall_pressure`, `wall_viscosity`);
 //! and the checks that the fluid stays out of it.
 
-use super::common::{time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants};
+use super::common::{rms_deviation, time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants};
 use super::params::{Params, Spec};
 use super::solid_common::{check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE};
 use super::tank::{Column, RHO0};
+use crate::solver::fracture;
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, Substeps, TimeSettings};
 use crate::solver::systems::{Body, BoundaryMaterial, ElasticSolid, SolidInit};
+use std::collections::BTreeMap;
 
 /// The parameters of a structure in a fluid with defaults `d` (the fluid's and the common
 /// ones come from the scene): its material and scheme, and its sub-steps.
@@ -210,4 +212,88 @@ pub fn reference_curve(text: &str, (key, which): (usize, &str), (t, value): (usi
         .collect();
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
+}
+
+/// What a fluid-structure scene follows over a run: a point of the structure (its
+/// displacement sampled as `tip_x`, `tip_y`), the water found outside the tank or inside the
+/// structure, and the structure's numerical fracture ([`fracture::Worst`], particles linked
+/// within 1.5 dx). Its metrics: `tip_x_max`, `tip_y_max` (the largest displacement over the
+/// run), `particles_lost` (the most water particles found lost at a sample or at the end),
+/// `clusters_max`, `max_gap`, and the RMS deviation from published curves.
+#[derive(Clone, Debug)]
+pub struct Watch {
+    /// The structure's body name.
+    pub body: &'static str,
+    /// Its followed point.
+    pub tip: Probe,
+    /// (t, tip_x, tip_y) samples.
+    pub samples: Vec<(f64, f64, f64)>,
+    lost_max: usize,
+    fracture: fracture::Worst,
+    /// The tank's width and the particle spacing.
+    tank: (f64, f64),
+}
+
+/// Particles closer than this many spacings are linked by the fracture detector (as the
+/// solid scenes link them).
+pub const LINK: f64 = 1.5;
+
+impl Watch {
+    /// Follows `tip` of structure `body` in a tank `tank_width` wide (spacing `dx`).
+    pub fn new(body: &'static str, tip: Probe, (tank_width, dx): (f64, f64)) -> Self {
+        Self { body, tip, samples: Vec::new(), lost_max: 0, fracture: Default::default(), tank: (tank_width, dx) }
+    }
+
+    fn solid<'a>(&self, sim: &'a Simulation<2>) -> &'a ElasticSolid<2> {
+        sim.solid(self.body).expect("the watched structure").0
+    }
+
+    fn lost(&self, sim: &Simulation<2>) -> usize {
+        let (tw, dx) = self.tank;
+        fluid_outside(sim, tw, dx) + fluid_inside(sim, self.body, dx)
+    }
+
+    /// One time-series row, `t, tip_x, tip_y, max_speed`, recorded.
+    pub fn sample(&mut self, sim: &Simulation<2>) -> Vec<(&'static str, f64)> {
+        let (t, d) = (sim.time(), self.tip.displacement(self.solid(sim)));
+        self.samples.push((t, d[0], d[1]));
+        self.lost_max = self.lost_max.max(self.lost(sim));
+        self.fracture.observe(&self.solid(sim).x, self.tank.1, LINK);
+        vec![("t", t), ("tip_x", d[0]), ("tip_y", d[1]), ("max_speed", sim.max_speed())]
+    }
+
+    /// The metrics at the end of a run, with `(metric, component, curve)`: the RMS
+    /// deviation of `tip_x` (component 0) or `tip_y` (1) from each published curve.
+    pub fn metrics(&self, sim: &Simulation<2>, published: &[(&str, usize, Vec<(f64, f64)>)]) -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost(sim)) as f64)]);
+        m.extend(self.fracture.with(&self.solid(sim).x, self.tank.1, LINK).metrics());
+        let series = |k: usize| -> Vec<(f64, f64)> {
+            self.samples.iter().map(|s| (s.0, if k == 0 { s.1 } else { s.2 })).collect()
+        };
+        for (k, name) in [(0, "tip_x_max"), (1, "tip_y_max")] {
+            if let Some(max) = series(k).iter().map(|s| s.1).reduce(f64::max) {
+                m.insert(name.into(), max);
+            }
+        }
+        for (name, k, curve) in published {
+            if let Some(r) = rms_deviation(&series(*k), curve) {
+                m.insert(name.to_string(), r);
+            }
+        }
+        m
+    }
+
+    /// What a checkpoint keeps of it.
+    pub fn save(&self) -> serde_json::Value {
+        serde_json::json!({ "samples": &self.samples, "lost_max": self.lost_max, "fracture": self.fracture })
+    }
+
+    /// Restores what [`save`](Self::save) kept.
+    pub fn load(&mut self, state: &serde_json::Value) -> Result<(), String> {
+        let bad = |e: serde_json::Error| format!("checkpoint: {e}");
+        self.samples = serde_json::from_value(state["samples"].clone()).map_err(bad)?;
+        self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
+        self.fracture = serde_json::from_value(state["fracture"].clone()).map_err(bad)?;
+        Ok(())
+    }
 }

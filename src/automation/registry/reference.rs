@@ -47,11 +47,22 @@ pub(super) fn read(loc: &Loc, span: Span, key: &str, r: &ReferenceFile) -> Resul
         })
     };
     let (ix, iy) = (col("x", &r.x)?, col("y", &r.y)?);
+    let selected: Vec<(usize, &str)> =
+        r.rows.iter().map(|(c, v)| Ok((col(&format!("rows.{c}"), c)?, v.as_str()))).collect::<Result<_, String>>()?;
+    let scale = match r.y_scale {
+        Some(f) if !(f.is_finite() && f != 0.0) => {
+            return Err(loc.err(span, &format!("{key}.y_scale"), format!("{f} must be a finite non-zero factor")))
+        }
+        f => f.unwrap_or(1.0),
+    };
     let (mut x, mut y) = (Vec::new(), Vec::new());
     for (i, rec) in rd.records().enumerate() {
         let row = i + 2; // the header is line 1
         let rec = rec
             .map_err(|e| loc.err(span.clone(), &format!("{key}.file"), format!("{}: {e}", path.display())))?;
+        if !selected.iter().all(|&(j, v)| rec.get(j).map(str::trim) == Some(v)) {
+            continue;
+        }
         let num = |j: usize, name: &str| -> Result<f64, String> {
             let s = rec.get(j).unwrap_or("").trim();
             s.parse::<f64>().map_err(|_| {
@@ -63,10 +74,11 @@ pub(super) fn read(loc: &Loc, span: Span, key: &str, r: &ReferenceFile) -> Resul
             })
         };
         x.push(num(ix, &r.x)?);
-        y.push(num(iy, &r.y)?);
+        y.push(num(iy, &r.y)? * scale);
     }
     if x.is_empty() {
-        return Err(loc.err(span, &format!("{key}.file"), format!("{}: no rows", path.display())));
+        let which = if selected.is_empty() { "" } else { " with the values of `rows`" };
+        return Err(loc.err(span, &format!("{key}.file"), format!("{}: no rows{which}", path.display())));
     }
     Ok(Reference {
         label: r.label.clone().unwrap_or_else(|| r.file.trim_end_matches(".csv").to_string()),
@@ -109,6 +121,24 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
 
     fn p_in(root: &Path, src: &str) -> Result<Problem, String> {
         parse(&root.join("problems/x.toml"), src, "quick")
+    }
+
+    /// `rows` keeps one curve of a file of several; `y_scale` converts its units.
+    #[test]
+    fn a_reference_selects_its_rows_and_scales_them() {
+        let root = with_reference("source,t,v\na,0.0,1.0\nb,0.0,5.0\na,1.0,2.0\n");
+        let one = PROFILE.replace(
+            r#"x = "Re100", y = "y", label = "Ghia et al. 1982""#,
+            r#"x = "t", y = "v", rows = { source = "a" }, y_scale = 1e-4"#,
+        );
+        let pr = p_in(root.path(), &format!("{GOOD}{one}")).unwrap();
+        let f = pr.figures.iter().find(|f| f.id == "prof").unwrap();
+        let FigureKind::Profile { references, .. } = &f.kind else { panic!("{:?}", f.kind) };
+        assert_eq!((references[0].x.clone(), references[0].y.clone()), (vec![0.0, 1.0], vec![1e-4, 2e-4]));
+        let none = one.replace(r#"source = "a""#, r#"source = "c""#);
+        assert!(p_in(root.path(), &format!("{GOOD}{none}")).unwrap_err().contains("no rows with the values of `rows`"));
+        let bad = one.replace(r#"source = "a""#, r#"kind = "a""#);
+        assert!(p_in(root.path(), &format!("{GOOD}{bad}")).unwrap_err().contains("no column `kind`"));
     }
 
     #[test]

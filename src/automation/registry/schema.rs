@@ -145,6 +145,12 @@ pub(super) struct ReferenceFile {
     pub(super) y: String,
     #[serde(default)]
     pub(super) label: Option<String>,
+    /// Only the rows whose named columns hold these values (a file of several curves).
+    #[serde(default)]
+    pub(super) rows: std::collections::BTreeMap<String, String>,
+    /// A factor on the `y` values as drawn (a file stored in other units).
+    #[serde(default)]
+    pub(super) y_scale: Option<f64>,
 }
 
 /// A `[[tables]]` entry.
