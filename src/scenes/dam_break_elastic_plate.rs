@@ -40,7 +40,8 @@ use crate::solver::simulation::Simulation;
 use std::collections::BTreeMap;
 use std::path::Path;
 
-const SUN2019: &str = include_str!("../../reference_data/sun2019_elastic_plate_dambreak_tip_x_displacement.csv");
+const SUN2019: &str =
+    include_str!("../../reference_data/sun2019_elastic_plate_dambreak_tip_x_displacement.csv");
 
 /// The plate's body name.
 const PLATE: &str = "plate";
@@ -65,7 +66,12 @@ fn params() -> Vec<Spec> {
         Spec::float("column_height", 0.292, Bound::Positive, "water column height H (m)"),
         Spec::float("tank_width", 0.584, Bound::Positive, "tank width (m)"),
         Spec::float("tank_height", 0.32, Bound::Positive, "tank wall height (m)"),
-        Spec::float("plate_x", 0.292, Bound::Positive, "the plate's centre line, from the tank's left wall (m)"),
+        Spec::float(
+            "plate_x",
+            0.292,
+            Bound::Positive,
+            "the plate's centre line, from the tank's left wall (m)",
+        ),
         Spec::float("plate_width", 0.012, Bound::Positive, "plate width (m)"),
         Spec::float("plate_height", 0.08, Bound::Positive, "plate height above the floor (m)"),
         Spec::float("alpha", 0.1, Bound::NonNegative, "the water's artificial viscosity alpha, eq. (28)"),
@@ -109,13 +115,22 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
         return bad("tank_width", format!("the tank is narrower than the column (column_width = {l})"));
     }
     if th < p.float("column_height") {
-        return bad("tank_height", format!("the tank is lower than the column (column_height = {})", p.float("column_height")));
+        return bad(
+            "tank_height",
+            format!("the tank is lower than the column (column_height = {})", p.float("column_height")),
+        );
     }
     if x1 > tw {
-        return bad("plate_width", format!("the plate (x from {x0} to {x1}) reaches beyond the tank (tank_width = {tw})"));
+        return bad(
+            "plate_width",
+            format!("the plate (x from {x0} to {x1}) reaches beyond the tank (tank_width = {tw})"),
+        );
     }
     if x0 < l {
-        return bad("plate_x", format!("the plate (x from {x0} to {x1}) overlaps the water column (column_width = {l})"));
+        return bad(
+            "plate_x",
+            format!("the plate (x from {x0} to {x1}) overlaps the water column (column_width = {l})"),
+        );
     }
     for key in ["plate_width", "plate_height"] {
         if p.float(key) < 2.0 * dx {
@@ -148,7 +163,9 @@ fn impact(p: &Params) -> Result<PlateImpact, String> {
     let layers = s.solid.support_layers() as i64;
     let columns = ((x0 / dx - 0.5).ceil() as i64)..=((x1 / dx - 0.5).ceil() as i64 - 1);
     let fixed: Vec<Vector<2>> = (-layers..0)
-        .flat_map(|j| columns.clone().map(move |i| Vector::<2>::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx)))
+        .flat_map(|j| {
+            columns.clone().map(move |i| Vector::<2>::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx))
+        })
         .filter(under_plate)
         .collect();
     let (fluid, wall) = column(p).bodies_without(p, (s.h, s.constants.c0, s.fluid, G), under_plate)?;
@@ -160,7 +177,8 @@ fn impact(p: &Params) -> Result<PlateImpact, String> {
     // Open above: the run-up jets rise far above the walls; a tank width on either side.
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-tw, -edge - clamp], [2.0 * tw, th + 8.0 * p.float("column_height")]);
-    let sim = s.simulation("dam_break_elastic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
+    let sim =
+        s.simulation("dam_break_elastic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
     Ok(PlateImpact { sim, watch: Watch::new(PLATE, tip, (tw, dx)) })
 }
 
@@ -201,6 +219,48 @@ impl SceneRun for PlateImpact {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The coarse dam break (3 particles across the plate) through the impact: at every
+    /// hundredth of a second to t = 0.2 s no water is inside the plate or beyond the walls.
+    #[test]
+    fn the_water_stays_out_of_the_plate_through_the_impact() {
+        let specs = params();
+        let mut p = Params::defaults(&specs);
+        for (key, value) in [("dx", "0.004"), ("tf", "0.2")] {
+            p.set_str("dam_break_elastic_plate", &specs, key, value).unwrap();
+        }
+        let mut run = impact(&p).unwrap();
+        let mut t = 0.0;
+        while t < 0.2 - 1e-9 {
+            t += 0.01;
+            run.sim.advance(t, 0.2, |_| true).unwrap();
+            run.sample();
+            assert_eq!(run.watch.metrics(&run.sim, &[])["particles_lost"], 0.0, "water lost by t = {t}");
+        }
+        let tip = run.watch.samples.last().unwrap().1;
+        assert!(tip > 0.005, "the water has pushed the plate's tip by {tip} m at t = 0.2 s");
+    }
+
+    /// Bad input is refused with its key named.
+    #[test]
+    fn bad_input_is_refused_by_key() {
+        let specs = params();
+        for (key, value, named) in [
+            ("plate_width", "0.6", "plate_width"),
+            ("plate_width", "-0.012", "plate_width"),
+            ("poisson_ratio", "0.5", "poisson_ratio"),
+            ("solid_substeps", "0", "solid_substeps"),
+            ("solid_substeps", "many", "solid_substeps"),
+            ("plate_x", "0.1", "plate_x"),
+        ] {
+            let mut p = Params::defaults(&specs);
+            let err = p
+                .set_str("dam_break_elastic_plate", &specs, key, value)
+                .and_then(|()| setup(&p).map(drop))
+                .expect_err(&format!("{key} = {value} accepted"));
+            assert!(err.contains(&format!("`{named}`")), "{key} = {value}: {err}");
+        }
+    }
 
     #[test]
     fn the_published_curves_parse() {

@@ -65,12 +65,22 @@ pub const ENTRY: SceneEntry = SceneEntry {
 fn params() -> Vec<Spec> {
     let mut v = vec![
         Spec::float("dx", 0.001, Bound::Positive, "particle spacing of water and gate (m)"),
-        Spec::float("column_width", 0.1, Bound::Positive, "water column width (m), from the left wall to the gate"),
+        Spec::float(
+            "column_width",
+            0.1,
+            Bound::Positive,
+            "water column width (m), from the left wall to the gate",
+        ),
         Spec::float("column_height", 0.14, Bound::Positive, "water column height H (m)"),
         Spec::float("gate_thickness", 0.005, Bound::Positive, "gate thickness (m)"),
         Spec::float("gate_length", 0.079, Bound::Positive, "gate length from the floor to its clamp (m)"),
         Spec::float("tank_width", 0.5, Bound::Positive, "tank width (m): the floor beyond the gate"),
-        Spec::float("tank_height", 0.16, Bound::Positive, "tank wall height (m), the rigid wall above the gate's too"),
+        Spec::float(
+            "tank_height",
+            0.16,
+            Bound::Positive,
+            "tank wall height (m), the rigid wall above the gate's too",
+        ),
         Spec::float("alpha", 0.05, Bound::NonNegative, "the water's artificial viscosity alpha, eq. (28)"),
     ];
     v.extend(scheme_params("sun"));
@@ -103,13 +113,19 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
     let (t, gl) = (p.float("gate_thickness"), p.float("gate_length"));
     let (tw, th, dx) = (p.float("tank_width"), p.float("tank_height"), p.float("dx"));
     if l + t > tw {
-        return bad("gate_thickness", format!("the gate (x from {l} to {}) reaches beyond the tank (tank_width = {tw})", l + t));
+        return bad(
+            "gate_thickness",
+            format!("the gate (x from {l} to {}) reaches beyond the tank (tank_width = {tw})", l + t),
+        );
     }
     if th < hc {
         return bad("tank_height", format!("the tank is lower than the column (column_height = {hc})"));
     }
     if gl >= hc {
-        return bad("gate_length", format!("the gate is as high as the water (column_height = {hc}): nothing holds it above"));
+        return bad(
+            "gate_length",
+            format!("the gate is as high as the water (column_height = {hc}): nothing holds it above"),
+        );
     }
     if t < 2.0 * dx {
         return bad("gate_thickness", format!("the gate needs at least two particles across (dx = {dx})"));
@@ -130,7 +146,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 
 fn gate(p: &Params) -> Result<Gate, String> {
     let s = setup(p)?;
-    let (dx, l, t, gl) = (p.float("dx"), p.float("column_width"), p.float("gate_thickness"), p.float("gate_length"));
+    let (dx, l, t, gl) =
+        (p.float("dx"), p.float("column_width"), p.float("gate_thickness"), p.float("gate_length"));
     let (tw, th) = (p.float("tank_width"), p.float("tank_height"));
     let (fluid, wall) = column(p).bodies(p, s.h, s.constants.c0, s.fluid, G)?;
     let free = lattice(l, l + t, 0.0, gl, dx);

@@ -7,9 +7,13 @@
 //! the fluid with the walls' models (`wall_density`, `wall_pressure`, `wall_viscosity`);
 //! and the checks that the fluid stays out of it.
 
-use super::common::{rms_deviation, time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants};
+use super::common::{
+    rms_deviation, time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants,
+};
 use super::params::{Params, Spec};
-use super::solid_common::{check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE};
+use super::solid_common::{
+    check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE,
+};
 use super::tank::{Column, RHO0};
 use crate::solver::fracture;
 use crate::solver::kernel::Kernel;
@@ -100,8 +104,13 @@ impl FsiSetup {
         let mut x = free;
         x.extend(fixed);
         let rho0 = s.material.rho0;
-        let init =
-            SolidInit { x, u: vec![Vector::zeros(); n], m: vec![rho0 * s.dx * s.dx; n], rho: vec![rho0; n], fixed: flags };
+        let init = SolidInit {
+            x,
+            u: vec![Vector::zeros(); n],
+            m: vec![rho0 * s.dx * s.dx; n],
+            rho: vec![rho0; n],
+            fixed: flags,
+        };
         let boundary = BoundaryMaterial {
             rho0: RHO0,
             c0: self.constants.c0,
@@ -142,16 +151,18 @@ impl FsiSetup {
 pub fn fluid_inside(sim: &Simulation<2>, name: &str, dx: f64) -> usize {
     let Some((s, _)) = sim.solid(name) else { return 0 };
     let r2 = (1.55 * dx) * (1.55 * dx);
-    let (lo, hi) = s.x.iter().fold(
-        (Vector::<2>::repeat(f64::INFINITY), Vector::<2>::repeat(f64::NEG_INFINITY)),
-        |(lo, hi), x| (lo.inf(x), hi.sup(x)),
-    );
+    let (lo, hi) =
+        s.x.iter().fold(
+            (Vector::<2>::repeat(f64::INFINITY), Vector::<2>::repeat(f64::NEG_INFINITY)),
+            |(lo, hi), x| (lo.inf(x), hi.sup(x)),
+        );
     let near_box = |x: &Vector<2>| (0..2).all(|k| x[k] > lo[k] - 2.0 * dx && x[k] < hi[k] + 2.0 * dx);
     let surrounded = |x: &Vector<2>| {
-        let (n, sum) = s.x.iter().map(|y| y - x).filter(|d| d.norm_squared() < r2).fold(
-            (0usize, Vector::<2>::zeros()),
-            |(n, sum), d| (n + 1, sum + d / d.norm().max(1e-300)),
-        );
+        let (n, sum) =
+            s.x.iter()
+                .map(|y| y - x)
+                .filter(|d| d.norm_squared() < r2)
+                .fold((0usize, Vector::<2>::zeros()), |(n, sum), d| (n + 1, sum + d / d.norm().max(1e-300)));
         n >= 4 && sum.norm() < 0.5 * n as f64
     };
     sim.fluid().x.iter().filter(|x| near_box(x) && surrounded(x)).count()
@@ -176,8 +187,13 @@ pub struct Probe {
 impl Probe {
     /// The mean of the free particles of `solid` at which `pick` holds (`what` names them in
     /// the error when there are none).
-    pub fn new(solid: &ElasticSolid<2>, what: &str, pick: impl Fn(&Vector<2>) -> bool) -> Result<Self, String> {
-        let indices: Vec<usize> = (0..solid.len()).filter(|&i| !solid.fixed[i] && pick(&solid.x[i])).collect();
+    pub fn new(
+        solid: &ElasticSolid<2>,
+        what: &str,
+        pick: impl Fn(&Vector<2>) -> bool,
+    ) -> Result<Self, String> {
+        let indices: Vec<usize> =
+            (0..solid.len()).filter(|&i| !solid.fixed[i] && pick(&solid.x[i])).collect();
         if indices.is_empty() {
             return Err(format!("solid `{}`: no particle at {what}", solid.name));
         }
@@ -200,7 +216,11 @@ impl Probe {
 /// The points `(t, value)` of the CSV `text` (a header row, then rows) whose column
 /// `source` equals `which`, with `t` and the value in the columns `t` and `value`, in time
 /// order.
-pub fn reference_curve(text: &str, (key, which): (usize, &str), (t, value): (usize, usize)) -> Vec<(f64, f64)> {
+pub fn reference_curve(
+    text: &str,
+    (key, which): (usize, &str),
+    (t, value): (usize, usize),
+) -> Vec<(f64, f64)> {
     let mut out: Vec<(f64, f64)> = text
         .lines()
         .skip(1)
@@ -241,7 +261,14 @@ pub const LINK: f64 = 1.5;
 impl Watch {
     /// Follows `tip` of structure `body` in a tank `tank_width` wide (spacing `dx`).
     pub fn new(body: &'static str, tip: Probe, (tank_width, dx): (f64, f64)) -> Self {
-        Self { body, tip, samples: Vec::new(), lost_max: 0, fracture: Default::default(), tank: (tank_width, dx) }
+        Self {
+            body,
+            tip,
+            samples: Vec::new(),
+            lost_max: 0,
+            fracture: Default::default(),
+            tank: (tank_width, dx),
+        }
     }
 
     fn solid<'a>(&self, sim: &'a Simulation<2>) -> &'a ElasticSolid<2> {
@@ -264,8 +291,13 @@ impl Watch {
 
     /// The metrics at the end of a run, with `(metric, component, curve)`: the RMS
     /// deviation of `tip_x` (component 0) or `tip_y` (1) from each published curve.
-    pub fn metrics(&self, sim: &Simulation<2>, published: &[(&str, usize, Vec<(f64, f64)>)]) -> BTreeMap<String, f64> {
-        let mut m = BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost(sim)) as f64)]);
+    pub fn metrics(
+        &self,
+        sim: &Simulation<2>,
+        published: &[(&str, usize, Vec<(f64, f64)>)],
+    ) -> BTreeMap<String, f64> {
+        let mut m =
+            BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost(sim)) as f64)]);
         m.extend(self.fracture.with(&self.solid(sim).x, self.tank.1, LINK).metrics());
         let series = |k: usize| -> Vec<(f64, f64)> {
             self.samples.iter().map(|s| (s.0, if k == 0 { s.1 } else { s.2 })).collect()

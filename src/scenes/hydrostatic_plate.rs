@@ -67,7 +67,12 @@ pub const ENTRY: SceneEntry = SceneEntry {
 
 fn params() -> Vec<Spec> {
     let mut v = vec![
-        Spec::float("dx", 0.005, Bound::Positive, "particle spacing of water and plate (m); 0.005: 10 across the plate"),
+        Spec::float(
+            "dx",
+            0.005,
+            Bound::Positive,
+            "particle spacing of water and plate (m); 0.005: 10 across the plate",
+        ),
         Spec::float("width", 1.0, Bound::Positive, "water and plate width = the plate's span L (m)"),
         Spec::float("water_height", 2.0, Bound::Positive, "water depth H (m)"),
         Spec::float("tank_height", 2.3, Bound::Positive, "side walls' height above the plate (m)"),
@@ -100,7 +105,8 @@ fn column(p: &Params) -> Column {
 const KEYS: [&str; 4] = ["width", "water_height", "width", "tank_height"];
 
 fn setup(p: &Params) -> Result<FsiSetup, String> {
-    let bad = |key: &str, why: &str| Err(format!("scene `hydrostatic_plate`: `{key}` = {}: {why}", p.float(key)));
+    let bad =
+        |key: &str, why: &str| Err(format!("scene `hydrostatic_plate`: `{key}` = {}: {why}", p.float(key)));
     let (dx, t) = (p.float("dx"), p.float("plate_thickness"));
     if t < 2.0 * dx {
         return bad("plate_thickness", "the plate needs at least two particles across (`dx` spacing)");
@@ -131,7 +137,8 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 /// The static mid-span deflection of eq. (4.16) under the water's and the plate's weight
 /// (negative: downward).
 pub fn static_deflection(p: &Params) -> f64 {
-    let (l, hw, t, g) = (p.float("width"), p.float("water_height"), p.float("plate_thickness"), p.float("gravity"));
+    let (l, hw, t, g) =
+        (p.float("width"), p.float("water_height"), p.float("plate_thickness"), p.float("gravity"));
     let (e, nu, rho_s) = (p.float("youngs_modulus"), p.float("poisson_ratio"), p.float("solid_density"));
     let q = g * (RHO0 * hw + rho_s * t);
     let d = e * t.powi(3) / (12.0 * (1.0 - nu * nu));
@@ -161,12 +168,7 @@ fn plate(p: &Params) -> Result<HydrostaticPlate, String> {
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-edge, -t - edge], [w + edge, p.float("tank_height") + edge]);
     let sim = s.simulation("hydrostatic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
-    Ok(HydrostaticPlate {
-        sim,
-        middle,
-        samples: Vec::new(),
-        geometry: (hw, w, g, dx, static_deflection(p)),
-    })
+    Ok(HydrostaticPlate { sim, middle, samples: Vec::new(), geometry: (hw, w, g, dx, static_deflection(p)) })
 }
 
 impl HydrostaticPlate {
@@ -186,7 +188,10 @@ impl SceneRun for HydrostaticPlate {
     forward_to_sim!();
     fn plan(&self) -> String {
         let (n, _) = self.sim.step_sizes();
-        plan(&self.sim, &format!("side walls of {LAYERS} layers on the plate's clamps; {n} plate steps per fluid step"))
+        plan(
+            &self.sim,
+            &format!("side walls of {LAYERS} layers on the plate's clamps; {n} plate steps per fluid step"),
+        )
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let (t, y) = (self.sim.time(), self.midspan_y());
@@ -201,7 +206,8 @@ impl SceneRun for HydrostaticPlate {
         let f = self.sim.fluid();
         let reference = RHO0 * g * hw;
         let p_err = if reference > 0.0 {
-            let sum: f64 = f.x.iter().zip(&f.p).map(|(x, p)| ((p - RHO0 * g * (hw - x[1])) / reference).powi(2)).sum();
+            let sum: f64 =
+                f.x.iter().zip(&f.p).map(|(x, p)| ((p - RHO0 * g * (hw - x[1])) / reference).powi(2)).sum();
             (sum / f.len() as f64).sqrt()
         } else {
             f.p.iter().map(|p| p.abs()).fold(0.0, f64::max)
@@ -223,7 +229,8 @@ impl SceneRun for HydrostaticPlate {
         serde_json::json!({ "sim": &self.sim.state, "samples": &self.samples })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.samples = serde_json::from_value(state["samples"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
+        self.samples =
+            serde_json::from_value(state["samples"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
         restore_sim(&mut self.sim, &state)
     }
 }
@@ -231,6 +238,27 @@ impl SceneRun for HydrostaticPlate {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A plate under still water without gravity carries no load: every force across the
+    /// interface balances, and after a hundred water steps (8200 plate steps) neither the
+    /// plate nor the water has moved.
+    #[test]
+    fn a_plate_under_still_water_without_load_stays_at_rest() {
+        let specs = params();
+        let mut p = Params::defaults(&specs);
+        for (key, value) in [("dx", "0.025"), ("gravity", "0")] {
+            p.set_str("hydrostatic_plate", &specs, key, value).unwrap();
+        }
+        let mut run = plate(&p).unwrap();
+        let x0 = run.sim.solid(PLATE).unwrap().0.x.clone();
+        for _ in 0..100 {
+            run.sim.step(f64::INFINITY).unwrap();
+        }
+        let (plate, _) = run.sim.solid(PLATE).unwrap();
+        let moved = plate.x.iter().zip(&x0).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max);
+        assert!(moved < 1e-12 && plate.max_speed() < 1e-12, "the plate moved {moved} m");
+        assert!(run.sim.max_speed() < 1e-12, "the water moves at {}", run.sim.max_speed());
+    }
 
     /// The defaults' static deflection is the thesis's -6.85e-5 m to its rounding (its
     /// author's 0.0026 for 1/384).

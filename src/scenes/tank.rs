@@ -100,8 +100,11 @@ impl Column {
         let fluid = fluid_at_rest(lattice(0.0, width, 0.0, height, dx), dx, RHO0, h, physics, hydrostatic)?;
         let mut walls = box_walls(tw, th, dx, LAYERS, false);
         walls.retain(|(x, _)| !removed(x));
-        let wall = wall_from(&walls, |_| Vector::zeros(), dx, RHO0, c0)?
-            .with_models(wall_density(p), wall_pressure(p), wall_viscosity(p));
+        let wall = wall_from(&walls, |_| Vector::zeros(), dx, RHO0, c0)?.with_models(
+            wall_density(p),
+            wall_pressure(p),
+            wall_viscosity(p),
+        );
         Ok((fluid, wall))
     }
 }

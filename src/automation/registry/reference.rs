@@ -47,11 +47,18 @@ pub(super) fn read(loc: &Loc, span: Span, key: &str, r: &ReferenceFile) -> Resul
         })
     };
     let (ix, iy) = (col("x", &r.x)?, col("y", &r.y)?);
-    let selected: Vec<(usize, &str)> =
-        r.rows.iter().map(|(c, v)| Ok((col(&format!("rows.{c}"), c)?, v.as_str()))).collect::<Result<_, String>>()?;
+    let selected: Vec<(usize, &str)> = r
+        .rows
+        .iter()
+        .map(|(c, v)| Ok((col(&format!("rows.{c}"), c)?, v.as_str())))
+        .collect::<Result<_, String>>()?;
     let scale = match r.y_scale {
         Some(f) if !(f.is_finite() && f != 0.0) => {
-            return Err(loc.err(span, &format!("{key}.y_scale"), format!("{f} must be a finite non-zero factor")))
+            return Err(loc.err(
+                span,
+                &format!("{key}.y_scale"),
+                format!("{f} must be a finite non-zero factor"),
+            ))
         }
         f => f.unwrap_or(1.0),
     };
@@ -136,7 +143,9 @@ reference = { file = "ref.csv", x = "Re100", y = "y", label = "Ghia et al. 1982"
         let FigureKind::Profile { references, .. } = &f.kind else { panic!("{:?}", f.kind) };
         assert_eq!((references[0].x.clone(), references[0].y.clone()), (vec![0.0, 1.0], vec![1e-4, 2e-4]));
         let none = one.replace(r#"source = "a""#, r#"source = "c""#);
-        assert!(p_in(root.path(), &format!("{GOOD}{none}")).unwrap_err().contains("no rows with the values of `rows`"));
+        assert!(p_in(root.path(), &format!("{GOOD}{none}"))
+            .unwrap_err()
+            .contains("no rows with the values of `rows`"));
         let bad = one.replace(r#"source = "a""#, r#"kind = "a""#);
         assert!(p_in(root.path(), &format!("{GOOD}{bad}")).unwrap_err().contains("no column `kind`"));
     }
