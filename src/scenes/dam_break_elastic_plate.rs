@@ -31,7 +31,7 @@ use super::common::{
 use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::SolidDefaults;
+use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
@@ -54,7 +54,15 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     check: |p| setup(p).map(drop),
-    metrics: &["tip_x_max", "tip_x_rms", "tip_x_rms_bogaers", "particles_lost", "clusters_max"],
+    metrics: &[
+        "tip_x_max",
+        "tip_x_rms",
+        "tip_x_rms_bogaers",
+        "particles_lost",
+        "clusters_max",
+        "max_gap",
+        "tip_y_max",
+    ],
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
@@ -120,23 +128,28 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
             format!("the tank is lower than the column (column_height = {})", p.float("column_height")),
         );
     }
+    let plate = format!(
+        "`plate_x` = {:?} and `plate_width` = {:?} put the plate from x = {x0:?} to {x1:?}",
+        p.float("plate_x"),
+        p.float("plate_width")
+    );
     if x1 > tw {
-        return bad(
-            "plate_width",
-            format!("the plate (x from {x0} to {x1}) reaches beyond the tank (tank_width = {tw})"),
-        );
+        return Err(format!("scene `{scene}`: {plate}, beyond the tank (`tank_width` = {tw:?})"));
     }
     if x0 < l {
-        return bad(
-            "plate_x",
-            format!("the plate (x from {x0} to {x1}) overlaps the water column (column_width = {l})"),
-        );
+        return Err(format!("scene `{scene}`: {plate}, into the water column (`column_width` = {l:?})"));
     }
     for key in ["plate_width", "plate_height"] {
         if p.float(key) < 2.0 * dx {
             return bad(key, format!("the plate needs at least two particles across (dx = {dx})"));
         }
     }
+    let (pw, ph) = (p.float("plate_width"), p.float("plate_height"));
+    check_count(
+        scene,
+        &format!("`dx` = {dx} (`plate_width` = {pw}, `plate_height` = {ph})"),
+        (pw / dx) * (ph / dx),
+    )?;
     // The plate's tip moves at most at the surge's speed, 2 sqrt(g H).
     let u = 2.0 * (G * p.float("column_height")).sqrt();
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)

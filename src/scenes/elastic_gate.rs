@@ -36,7 +36,7 @@ use super::common::{
 use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::SolidDefaults;
+use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
@@ -57,7 +57,15 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     check: |p| setup(p).map(drop),
-    metrics: &["tip_x_max", "tip_y_max", "tip_x_rms", "tip_y_rms", "particles_lost", "clusters_max"],
+    metrics: &[
+        "tip_x_max",
+        "tip_y_max",
+        "tip_x_rms",
+        "tip_y_rms",
+        "particles_lost",
+        "clusters_max",
+        "max_gap",
+    ],
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
@@ -113,10 +121,10 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
     let (t, gl) = (p.float("gate_thickness"), p.float("gate_length"));
     let (tw, th, dx) = (p.float("tank_width"), p.float("tank_height"), p.float("dx"));
     if l + t > tw {
-        return bad(
-            "gate_thickness",
-            format!("the gate (x from {l} to {}) reaches beyond the tank (tank_width = {tw})", l + t),
-        );
+        return Err(format!(
+            "scene `{scene}`: `column_width` = {l:?} and `gate_thickness` = {t:?} put the gate's far face at x = {:?}, beyond the tank (`tank_width` = {tw:?})",
+            l + t
+        ));
     }
     if th < hc {
         return bad("tank_height", format!("the tank is lower than the column (column_height = {hc})"));
@@ -127,9 +135,19 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
             format!("the gate is as high as the water (column_height = {hc}): nothing holds it above"),
         );
     }
-    if t < 2.0 * dx {
-        return bad("gate_thickness", format!("the gate needs at least two particles across (dx = {dx})"));
+    for key in ["gate_thickness", "gate_length"] {
+        if p.float(key) < 2.0 * dx {
+            return bad(
+                key,
+                format!("the gate needs at least two particles across it and along it (dx = {dx})"),
+            );
+        }
     }
+    check_count(
+        scene,
+        &format!("`dx` = {dx} (`gate_thickness` = {t}, `tank_height` = {th})"),
+        (t / dx) * (th / dx),
+    )?;
     // The free end swings at most at the water's outflow speed, sqrt(2 g H).
     let u = (2.0 * G * hc).sqrt();
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)

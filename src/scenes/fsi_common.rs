@@ -32,9 +32,15 @@ pub fn structure_params(d: &SolidDefaults) -> Vec<Spec> {
         "solid_substeps",
         1,
         "steps of the structure per step of the fluid, the fluid's force held over them: auto (the ratio of the two time-step limits, eqs. 61-62, rounded up) or a number (1: no sub-steps, both at the smaller limit)",
-    ));
+    )
+    // A bound on the work of one step: Ctrl-C is seen between steps.
+    .at_most(MAX_SUBSTEPS as f64));
     v
 }
+
+/// The most sub-steps a structure may take per fluid step (given or `auto`): an aluminium
+/// plate in water takes about eighty.
+pub const MAX_SUBSTEPS: u32 = 10_000;
 
 /// The sub-steps `p` asks for.
 pub fn substeps(p: &Params) -> Substeps {
@@ -78,6 +84,17 @@ pub fn fsi_setup(
         return Err(format!(
             "scene `{scene}`: `kernel` = {}: the structure's solid takes the quintic spline, and one kernel serves both bodies",
             p.str("kernel")
+        ));
+    }
+    // The structure's steps per water step follow the ratio of the sound speeds (eqs.
+    // 61-62 at rest): bounded, so that one step ends in reasonable time.
+    let ratio = solid.material.c0() / constants.c0;
+    if ratio > MAX_SUBSTEPS as f64 {
+        return Err(format!(
+            "scene `{scene}`: `youngs_modulus` = {:?}: the structure's sound speed {:.3e} m/s is {ratio:.3e} times the water's ({:.3e} m/s), more than {MAX_SUBSTEPS} structure steps per water step",
+            p.float("youngs_modulus"),
+            solid.material.c0(),
+            constants.c0
         ));
     }
     Ok(FsiSetup { constants, kernel, h, fluid, solid, substeps: substeps(p) })
@@ -254,6 +271,10 @@ pub struct Watch {
     tank: (f64, f64),
 }
 
+/// A published curve a metric measures the run against: the metric's name, the component
+/// of the displacement (0: x, 1: y), and the curve's (t, value) points.
+pub type Published<'a> = (&'a str, usize, Vec<(f64, f64)>);
+
 /// Particles closer than this many spacings are linked by the fracture detector (as the
 /// solid scenes link them).
 pub const LINK: f64 = 1.5;
@@ -291,11 +312,7 @@ impl Watch {
 
     /// The metrics at the end of a run, with `(metric, component, curve)`: the RMS
     /// deviation of `tip_x` (component 0) or `tip_y` (1) from each published curve.
-    pub fn metrics(
-        &self,
-        sim: &Simulation<2>,
-        published: &[(&str, usize, Vec<(f64, f64)>)],
-    ) -> BTreeMap<String, f64> {
+    pub fn metrics(&self, sim: &Simulation<2>, published: &[Published]) -> BTreeMap<String, f64> {
         let mut m =
             BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost(sim)) as f64)]);
         m.extend(self.fracture.with(&self.solid(sim).x, self.tank.1, LINK).metrics());

@@ -38,7 +38,7 @@ use super::common::{
 use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, structure_params, FsiSetup, Probe};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::SolidDefaults;
+use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, LAYERS, RHO0};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
@@ -112,8 +112,18 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
         return bad("plate_thickness", "the plate needs at least two particles across (`dx` spacing)");
     }
     if p.float("tank_height") < p.float("water_height") {
-        return bad("tank_height", "the walls are lower than the water");
+        return Err(format!(
+            "scene `hydrostatic_plate`: `tank_height` = {:?} is lower than `water_height` = {:?}",
+            p.float("tank_height"),
+            p.float("water_height")
+        ));
     }
+    let w = p.float("width");
+    check_count(
+        "hydrostatic_plate",
+        &format!("`dx` = {dx} (`width` = {w}, `plate_thickness` = {t})"),
+        (w / dx) * (t / dx),
+    )?;
     let g = p.float("gravity");
     // The plate barely moves: its speed stays below the water's sqrt(2 g H).
     let u = (2.0 * 9.81 * p.float("water_height")).sqrt();

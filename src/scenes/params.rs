@@ -216,7 +216,12 @@ impl Spec {
             (Kind::Choice(c), Value::Str(s)) if c.contains(&s.as_str()) => Ok(v.clone()),
             (Kind::Choice(c), _) => Err(bad(&format!("expected one of {}", c.join(", ")))),
             (Kind::AutoOrInt { .. }, Value::Str(s)) if s == "auto" => Ok(v.clone()),
-            (Kind::AutoOrInt { min }, Value::Int(i)) if *i >= min => Ok(v.clone()),
+            (Kind::AutoOrInt { min }, Value::Int(i)) if *i >= min => {
+                match self.max.filter(|&m| *i as f64 > m) {
+                    Some(max) => Err(bad(&format!("must be auto or <= {max}"))),
+                    None => Ok(v.clone()),
+                }
+            }
             (Kind::AutoOrInt { min }, _) => Err(bad(&format!("expected auto or an integer >= {min}"))),
         }
     }

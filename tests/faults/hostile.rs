@@ -82,6 +82,9 @@ fn hostile_values(spec: &Spec) -> Vec<&'static str> {
         Kind::Int { .. } => vec!["0", "-1", "9223372036854775807", "99999999999999999999"],
         Kind::Bool => vec!["maybe", ""],
         Kind::Choice(_) => vec!["no_such_name", ""],
+        Kind::AutoOrInt { .. } => {
+            vec!["0", "-1", "9223372036854775807", "99999999999999999999", "no_such_name", ""]
+        }
     }
 }
 
@@ -92,6 +95,7 @@ fn other_valid_value(spec: &Spec) -> String {
         (Kind::Float { .. }, _) => "0.5".into(),
         (Kind::Int { .. }, Value::Int(i)) => format!("{}", i + 1),
         (Kind::Bool, Value::Bool(b)) => format!("{}", !b),
+        (Kind::AutoOrInt { .. }, _) => "2".into(),
         (Kind::Choice(names), d) => {
             names.iter().find(|n| d.to_string() != **n).unwrap_or(&names[0]).to_string()
         }

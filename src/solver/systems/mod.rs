@@ -8,7 +8,9 @@
 //! - [`fluid`]: a weakly compressible fluid (CTVF sec. 2-3), integrated;
 //! - [`wall`]: wall particles with a prescribed motion, not integrated, presenting
 //!   extrapolated values to the fluid through the [`boundary`] model they embed;
-//! - [`elastic_solid`]: an elastic solid (CTVF sec. 2-3, eqs. 8, 25, 30-32), integrated.
+//! - [`elastic_solid`]: an elastic solid (CTVF sec. 2-3, eqs. 8, 25, 30-32), integrated; in a
+//!   fluid it is also a structure, presenting the boundary model to the fluid (thesis
+//!   sec. 4.2.4).
 //!
 //! Who acts on whom is decided in [`interactions`](crate::solver::interactions), by one
 //! exhaustive `match` over the [`BodyKind`]s.
