@@ -173,8 +173,10 @@ fn gate(p: &Params) -> Result<Gate, String> {
     let what = format!("`dx` = {dx} (`gate_thickness` = {t}, `tank_height` = {th})");
     let gate = s.structure(("elastic_gate", &what), GATE, free, fixed, p)?;
     let tip = Probe::new(&gate, "the gate's free end", |x| x[1] < dx)?;
+    // Open above: the water running back up the left wall splashes over it; a tank width
+    // on either side and eight water heights above (as the dam break's box).
     let edge = (LAYERS as f64 + 1.0) * dx;
-    let domain = Domain::bounded([-edge, -edge], [tw + edge, th + 4.0 * p.float("column_height")]);
+    let domain = Domain::bounded([-tw, -edge], [2.0 * tw, th + 8.0 * p.float("column_height")]);
     let sim = s.simulation("elastic_gate", p, domain, [fluid.into(), wall.into(), gate.into()])?;
     Ok(Gate { sim, watch: Watch::new(GATE, tip, (tw, dx)) })
 }
