@@ -18,7 +18,7 @@
 
 use super::cache::{self, Entry};
 use super::registry::{FigureKind, Problem};
-use super::study::snapshot::{drawn_series, pick_snapshot, pvd_entries, pvd_text};
+use super::study::snapshot::{drawn_series, pick_snapshot, pvd_entries, pvd_text, snapshot_series};
 use crate::solver::output::summary::{Status, Summary};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
@@ -129,11 +129,9 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
             out.cases += 1;
         }
         // The snapshots the particle figures draw: of the first selected case with a result,
-        // the one nearest the figure's time, and the walls' nearest it.
-        // Per case folder: where it is exported, the series drawn, its files and the walls'.
-        #[allow(clippy::type_complexity)]
-        let mut snaps: BTreeMap<PathBuf, (PathBuf, String, BTreeSet<String>, BTreeSet<String>)> =
-            BTreeMap::new();
+        // the one nearest the figure's time, and the walls' and the structures' nearest it.
+        // Per case folder: where it is exported, and the files of each series drawn.
+        let mut snaps: BTreeMap<PathBuf, (PathBuf, BTreeMap<String, BTreeSet<String>>)> = BTreeMap::new();
         for f in &p.figures {
             let FigureKind::Particles { time, .. } = &f.kind else { continue };
             let drawn = f
@@ -146,20 +144,19 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
             let series = drawn_series(&e.dir)?;
             let list = pvd_entries(&e.dir, &series)?;
             let (t, file) = pick_snapshot(&list, *time).clone();
-            let slot = snaps
-                .entry(e.dir.clone())
-                .or_insert_with(|| (dest(&e), series, BTreeSet::new(), BTreeSet::new()));
-            slot.2.insert(file);
-            if e.dir.join("wall.pvd").exists() {
-                let walls = pvd_entries(&e.dir, "wall.pvd")?;
-                slot.3.insert(pick_snapshot(&walls, Some(t)).1.clone());
-            }
-        }
-        for (from, (to, drawn, fluid, wall)) in snaps {
-            for (series, files) in [(drawn.as_str(), &fluid), ("wall.pvd", &wall)] {
-                if files.is_empty() {
+            let slot = snaps.entry(e.dir.clone()).or_insert_with(|| (dest(&e), BTreeMap::new()));
+            slot.1.entry(series.clone()).or_default().insert(file);
+            // Beside the drawn series: the walls, and the structures beside a fluid.
+            for other in snapshot_series(&e.dir)? {
+                if other == series || (other != "wall.pvd" && series != "fluid.pvd") {
                     continue;
                 }
+                let entries = pvd_entries(&e.dir, &other)?;
+                slot.1.entry(other).or_default().insert(pick_snapshot(&entries, Some(t)).1.clone());
+            }
+        }
+        for (from, (to, drawn)) in snaps {
+            for (series, files) in &drawn {
                 let list: Vec<(f64, String)> =
                     pvd_entries(&from, series)?.into_iter().filter(|(_, f)| files.contains(f)).collect();
                 for (_, f) in &list {
@@ -172,7 +169,7 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
             }
             // Snapshots of an earlier export that no figure draws now.
             let keep: BTreeSet<PathBuf> =
-                fluid.iter().chain(&wall).map(|f| to.join(format!("{f}.gz"))).collect();
+                drawn.values().flatten().map(|f| to.join(format!("{f}.gz"))).collect();
             if let Ok(rd) = std::fs::read_dir(to.join("vtu")) {
                 for old in rd.flatten().map(|e| e.path()) {
                     if old.extension().is_some_and(|x| x == "gz") && !keep.contains(&old) {

@@ -34,6 +34,8 @@ pub struct ScatterField {
     pub y_label: String,
     /// Wall particles (x, y), drawn in grey under the fluid.
     pub walls: Option<(Vec<f64>, Vec<f64>)>,
+    /// The particles of structures in the fluid (x, y), drawn in dark red beside it.
+    pub structures: Option<(Vec<f64>, Vec<f64>)>,
     /// The data extent `[x0, x1, y0, y1]` to show (the panels of one figure share one);
     /// `None` fits the particles and walls.
     pub extent: Option<[f64; 4]>,
@@ -63,6 +65,8 @@ pub struct Arrows {
 const ARROW: RGBColor = RGBColor(215, 48, 39);
 /// Colour of the wall particles.
 const WALL: RGBColor = RGBColor(150, 150, 150);
+/// The colour of a structure's particles in a fluid's figure.
+const STRUCTURE: RGBColor = RGBColor(150, 30, 30);
 /// The shortest arrow drawn, in pixels: shorter ones cannot be seen.
 pub const MIN_ARROW_PX: f64 = 14.0;
 
@@ -233,9 +237,9 @@ impl ScatterField {
         let (x, y) = match self.extent {
             Some([x0, x1, y0, y1]) => (Axis::fit([x0, x1], false), Axis::fit([y0, y1], false)),
             None => {
-                let walls = self.walls.as_ref();
-                let xs = self.x.iter().chain(walls.into_iter().flat_map(|w| w.0.iter())).copied();
-                let ys = self.y.iter().chain(walls.into_iter().flat_map(|w| w.1.iter())).copied();
+                let others = self.walls.iter().chain(self.structures.iter());
+                let xs = self.x.iter().chain(others.clone().flat_map(|w| w.0.iter())).copied();
+                let ys = self.y.iter().chain(others.flat_map(|w| w.1.iter())).copied();
                 (Axis::fit(xs, false), Axis::fit(ys, false))
             }
         };
@@ -280,11 +284,13 @@ impl Render for ScatterField {
         // Dots as wide as the particle spacing, so that a fluid reads as one.
         let spacing = typical_spacing(&self.x[..n], &self.y[..n]);
         let r = (0.55 * spacing / per_px).clamp(1.0, 6.0).round() as i32;
-        if let Some((wx, wy)) = &self.walls {
-            let walls = wx.iter().zip(wy).filter(|(a, b)| a.is_finite() && b.is_finite());
-            chart
-                .draw_series(walls.map(|(a, b)| Circle::new((*a, *b), r, WALL.filled())))
-                .map_err(|e| e.to_string())?;
+        for (points, colour) in [(&self.walls, WALL), (&self.structures, STRUCTURE)] {
+            if let Some((px, py)) = points {
+                let points = px.iter().zip(py).filter(|(a, b)| a.is_finite() && b.is_finite());
+                chart
+                    .draw_series(points.map(|(a, b)| Circle::new((*a, *b), r, colour.filled())))
+                    .map_err(|e| e.to_string())?;
+            }
         }
         let dots = (0..n).filter(|&i| self.x[i].is_finite() && self.y[i].is_finite()).map(|i| {
             let c = viridis((self.value[i] - lo) / (hi - lo));
@@ -373,6 +379,7 @@ mod tests {
             x_label: "x (m)".into(),
             y_label: "y (m)".into(),
             walls: None,
+            structures: None,
             extent: None,
             range: None,
             aspect_equal: true,
@@ -402,6 +409,7 @@ mod tests {
                 x_label: "x (m)".into(),
                 y_label: "y (m)".into(),
                 walls: None,
+                structures: None,
                 extent: None,
                 range: None,
                 aspect_equal: false,
@@ -427,6 +435,7 @@ mod tests {
             x_label: "x (m)".into(),
             y_label: "y (m)".into(),
             walls: None,
+            structures: None,
             extent: None,
             range: Some((2.0, 4.0)),
             aspect_equal: false,
@@ -474,6 +483,7 @@ mod tests {
             x_label: "x (m)".into(),
             y_label: "y (m)".into(),
             walls: Some(walls),
+            structures: None,
             extent: None,
             range: None,
             aspect_equal: true,

@@ -455,6 +455,7 @@ fn prepare(
                 x_label: "x (m)".into(),
                 y_label: "y (m)".into(),
                 walls: s.walls,
+                structures: s.structures,
                 extent: None,
                 range: None,
                 aspect_equal: true,
@@ -510,7 +511,7 @@ fn share_axes(p: &Problem, prepared: &mut [Prepared]) {
                 }
                 Prepared::Particles(fig, ..) => {
                     extend(&mut ext, &fig.x, &fig.y, false);
-                    if let Some((wx, wy)) = &fig.walls {
+                    for (wx, wy) in fig.walls.iter().chain(fig.structures.iter()) {
                         extend(&mut ext, wx, wy, false);
                     }
                     for v in fig.value.iter().filter(|v| v.is_finite()) {

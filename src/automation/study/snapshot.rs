@@ -32,14 +32,11 @@ pub(crate) fn drawn_series(dir: &Path) -> Result<String, String> {
     if dir.join("fluid.pvd").exists() {
         return Ok("fluid.pvd".into());
     }
-    let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let mut names: Vec<String> = rd
-        .flatten()
-        .filter_map(|e| e.file_name().into_string().ok())
-        .filter(|n| n.ends_with(".pvd") && n != "wall.pvd")
-        .collect();
-    names.sort();
-    names.into_iter().next().ok_or_else(|| format!("{}: no snapshot series (*.pvd)", dir.display()))
+    let names = snapshot_series(dir)?;
+    names
+        .into_iter()
+        .find(|n| n != "wall.pvd")
+        .ok_or_else(|| format!("{}: no snapshot series (*.pvd)", dir.display()))
 }
 
 /// The entry nearest `time` (the first of equally near ones), or the last one.
@@ -181,6 +178,9 @@ pub(crate) struct Snapshot {
     pub arrows: Option<(Vec<f64>, Vec<f64>)>,
     /// The walls' particles at the nearest time (`wall.pvd`), if the case has walls.
     pub walls: Option<(Vec<f64>, Vec<f64>)>,
+    /// The particles of the other bodies (structures in the fluid) at the nearest time, when
+    /// the drawn series is the fluid's.
+    pub structures: Option<(Vec<f64>, Vec<f64>)>,
     /// Its time.
     pub t: f64,
 }
@@ -195,7 +195,8 @@ pub(crate) fn snapshot(
     time: Option<f64>,
     arrows: Option<&str>,
 ) -> Result<Option<Snapshot>, String> {
-    let list = pvd_entries(dir, &drawn_series(dir)?)?;
+    let drawn = drawn_series(dir)?;
+    let list = pvd_entries(dir, &drawn)?;
     let (t, file) = pick_snapshot(&list, time).clone();
     let Some((path, xml)) = read_vtu(dir, &file)? else {
         return Ok(None);
@@ -203,18 +204,46 @@ pub(crate) fn snapshot(
     let vtu = Vtu::parse(path, xml)?;
     let value = vtu.field(field)?;
     let arrows = arrows.map(|a| vtu.vectors(a)).transpose()?;
-    let walls = if dir.join("wall.pvd").exists() {
-        let wl = pvd_entries(dir, "wall.pvd")?;
-        let (_, wfile) = pick_snapshot(&wl, Some(t)).clone();
-        match read_vtu(dir, &wfile)? {
-            Some((p, x)) => {
-                let w = Vtu::parse(p, x)?;
-                Some((w.x, w.y))
+    let walls = points_at(dir, "wall.pvd", t)?;
+    // Structures in a fluid: every series besides the fluid's and the walls'.
+    let mut structures: Option<(Vec<f64>, Vec<f64>)> = None;
+    if drawn == "fluid.pvd" {
+        for name in snapshot_series(dir)?.into_iter().filter(|n| n != "fluid.pvd" && n != "wall.pvd") {
+            if let Some((x, y)) = points_at(dir, &name, t)? {
+                let s = structures.get_or_insert_with(Default::default);
+                s.0.extend(x);
+                s.1.extend(y);
             }
-            None => None,
         }
-    } else {
-        None
-    };
-    Ok(Some(Snapshot { x: vtu.x, y: vtu.y, value, arrows, walls, t }))
+    }
+    Ok(Some(Snapshot { x: vtu.x, y: vtu.y, value, arrows, walls, structures, t }))
+}
+
+/// The particles of series `name` in `dir` at the snapshot nearest `t`; `None` when the
+/// case has no such series or the file it lists is not there.
+fn points_at(dir: &Path, name: &str, t: f64) -> Result<Option<(Vec<f64>, Vec<f64>)>, String> {
+    if !dir.join(name).exists() {
+        return Ok(None);
+    }
+    let list = pvd_entries(dir, name)?;
+    let (_, file) = pick_snapshot(&list, Some(t)).clone();
+    Ok(match read_vtu(dir, &file)? {
+        Some((p, x)) => {
+            let v = Vtu::parse(p, x)?;
+            Some((v.x, v.y))
+        }
+        None => None,
+    })
+}
+
+/// The snapshot series (`*.pvd`) of case folder `dir`, by name.
+pub(crate) fn snapshot_series(dir: &Path) -> Result<Vec<String>, String> {
+    let rd = std::fs::read_dir(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut names: Vec<String> = rd
+        .flatten()
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n.ends_with(".pvd"))
+        .collect();
+    names.sort();
+    Ok(names)
 }
