@@ -206,7 +206,7 @@ pub(crate) fn snapshot(
     let arrows = arrows.map(|a| vtu.vectors(a)).transpose()?;
     let walls = points_at(dir, "wall.pvd", t)?;
     // Structures in a fluid: every series besides the fluid's and the walls'.
-    let mut structures: Option<(Vec<f64>, Vec<f64>)> = None;
+    let mut structures: Option<Points> = None;
     if drawn == "fluid.pvd" {
         for name in snapshot_series(dir)?.into_iter().filter(|n| n != "fluid.pvd" && n != "wall.pvd") {
             if let Some((x, y)) = points_at(dir, &name, t)? {
@@ -219,9 +219,12 @@ pub(crate) fn snapshot(
     Ok(Some(Snapshot { x: vtu.x, y: vtu.y, value, arrows, walls, structures, t }))
 }
 
+/// Particle positions: x and y.
+type Points = (Vec<f64>, Vec<f64>);
+
 /// The particles of series `name` in `dir` at the snapshot nearest `t`; `None` when the
 /// case has no such series or the file it lists is not there.
-fn points_at(dir: &Path, name: &str, t: f64) -> Result<Option<(Vec<f64>, Vec<f64>)>, String> {
+fn points_at(dir: &Path, name: &str, t: f64) -> Result<Option<Points>, String> {
     if !dir.join(name).exists() {
         return Ok(None);
     }
