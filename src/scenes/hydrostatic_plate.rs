@@ -197,7 +197,7 @@ impl HydrostaticPlate {
 impl SceneRun for HydrostaticPlate {
     forward_to_sim!();
     fn plan(&self) -> String {
-        let (n, _) = self.sim.step_sizes();
+        let (_, n) = self.sim.step_sizes();
         plan(
             &self.sim,
             &format!("side walls of {LAYERS} layers on the plate's clamps; {n} plate steps per fluid step"),
