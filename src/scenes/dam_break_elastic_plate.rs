@@ -24,11 +24,8 @@
 //! within 1.5 dx; 1 cluster: intact); `particles_lost`, water particles beyond the outer layer of the tank's walls or inside the plate, at the end or at any sample before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
-use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
-    wall_params,
-};
-use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
+use super::common::{free_surface_params, scheme_params, wall_params};
+use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, StructureRun, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{check_count, SolidDefaults};
@@ -36,9 +33,6 @@ use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::simulation::Simulation;
-use std::collections::BTreeMap;
-use std::path::Path;
 
 const SUN2019: &str =
     include_str!("../../reference_data/sun2019_elastic_plate_dambreak_tip_x_displacement.csv");
@@ -155,16 +149,11 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)
 }
 
-struct PlateImpact {
-    sim: Simulation<2>,
-    watch: Watch,
-}
-
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     Ok(Box::new(impact(p)?))
 }
 
-fn impact(p: &Params) -> Result<PlateImpact, String> {
+fn impact(p: &Params) -> Result<StructureRun, String> {
     let s = setup(p)?;
     let (dx, tw, th) = (p.float("dx"), p.float("tank_width"), p.float("tank_height"));
     let (x0, x1) = plate_span(p);
@@ -192,41 +181,22 @@ fn impact(p: &Params) -> Result<PlateImpact, String> {
     let domain = Domain::bounded([-tw, -edge - clamp], [2.0 * tw, th + 8.0 * p.float("column_height")]);
     let sim =
         s.simulation("dam_break_elastic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
-    Ok(PlateImpact { sim, watch: Watch::new(PLATE, tip, (tw, dx)) })
+    let watch = Watch::new(PLATE, tip, (tw, dx));
+    Ok(StructureRun {
+        sim,
+        watch,
+        published: vec![
+            ("tip_x_rms", 0, published("sun_2019_mps_dem")),
+            ("tip_x_rms_bogaers", 0, published("bogaers_2016_qn_ls")),
+        ],
+        held: "the plate clamped through the floor",
+    })
 }
 
 /// Sun et al.'s (2019) MPS-DEM curve of the tip's x displacement, or another `source` of
 /// the reference file.
 fn published(source: &str) -> Vec<(f64, f64)> {
     reference_curve(SUN2019, (0, source), (1, 2))
-}
-
-impl SceneRun for PlateImpact {
-    forward_to_sim!();
-    fn plan(&self) -> String {
-        let (_, n) = self.sim.step_sizes();
-        plan(&self.sim, &format!("{LAYERS} wall layers, open top; the plate clamped through the floor; {n} plate steps per fluid step"))
-    }
-    fn sample(&mut self) -> Vec<(&'static str, f64)> {
-        self.watch.sample(&self.sim)
-    }
-    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
-        snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
-    }
-    fn metrics(&self) -> BTreeMap<String, f64> {
-        let published = [
-            ("tip_x_rms", 0, published("sun_2019_mps_dem")),
-            ("tip_x_rms_bogaers", 0, published("bogaers_2016_qn_ls")),
-        ];
-        self.watch.metrics(&self.sim, &published)
-    }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.watch.load(&state["watch"])?;
-        restore_sim(&mut self.sim, &state)
-    }
 }
 
 #[cfg(test)]

@@ -30,20 +30,14 @@
 //! before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
-use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
-    wall_params,
-};
-use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, Watch};
+use super::common::{free_surface_params, scheme_params, wall_params};
+use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, StructureRun, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
-use crate::solver::simulation::Simulation;
-use std::collections::BTreeMap;
-use std::path::Path;
 
 const ANTOCI: &str = include_str!("../../reference_data/antoci2007_gate_tip_displacement.csv");
 
@@ -154,16 +148,11 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)
 }
 
-struct Gate {
-    sim: Simulation<2>,
-    watch: Watch,
-}
-
 fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
     Ok(Box::new(gate(p)?))
 }
 
-fn gate(p: &Params) -> Result<Gate, String> {
+fn gate(p: &Params) -> Result<StructureRun, String> {
     let s = setup(p)?;
     let (dx, l, t, gl) =
         (p.float("dx"), p.float("column_width"), p.float("gate_thickness"), p.float("gate_length"));
@@ -179,37 +168,18 @@ fn gate(p: &Params) -> Result<Gate, String> {
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-tw, -edge], [2.0 * tw, th + 8.0 * p.float("column_height")]);
     let sim = s.simulation("elastic_gate", p, domain, [fluid.into(), wall.into(), gate.into()])?;
-    Ok(Gate { sim, watch: Watch::new(GATE, tip, (tw, dx)) })
+    let watch = Watch::new(GATE, tip, (tw, dx));
+    Ok(StructureRun {
+        sim,
+        watch,
+        published: vec![("tip_x_rms", 0, measured("x")), ("tip_y_rms", 1, measured("y"))],
+        held: "the gate clamped to a rigid wall above it",
+    })
 }
 
 /// Antoci et al.'s measured free-end displacement, component `x` or `y`.
 fn measured(component: &str) -> Vec<(f64, f64)> {
     reference_curve(ANTOCI, (1, component), (2, 3))
-}
-
-impl SceneRun for Gate {
-    forward_to_sim!();
-    fn plan(&self) -> String {
-        let (_, n) = self.sim.step_sizes();
-        plan(&self.sim, &format!("{LAYERS} wall layers, open top; the gate clamped to a rigid wall above it; {n} gate steps per fluid step"))
-    }
-    fn sample(&mut self) -> Vec<(&'static str, f64)> {
-        self.watch.sample(&self.sim)
-    }
-    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
-        snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
-    }
-    fn metrics(&self) -> BTreeMap<String, f64> {
-        let published = [("tip_x_rms", 0, measured("x")), ("tip_y_rms", 1, measured("y"))];
-        self.watch.metrics(&self.sim, &published)
-    }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.watch.load(&state["watch"])?;
-        restore_sim(&mut self.sim, &state)
-    }
 }
 
 #[cfg(test)]

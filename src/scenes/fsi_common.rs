@@ -8,13 +8,16 @@
 //! and the checks that the fluid stays out of it.
 
 use super::common::{
-    rms_deviation, time_settings, wall_density, wall_pressure, wall_viscosity, FluidConstants,
+    forward_to_sim, plan, restore_sim, rms_deviation, snapshot_bodies, surface_fields, time_settings,
+    wall_density, wall_pressure, wall_viscosity, FluidConstants,
 };
 use super::params::{Params, Spec};
 use super::solid_common::{
     check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE,
 };
+use super::tank::LAYERS;
 use super::tank::{Column, RHO0};
+use super::SceneRun;
 use crate::solver::fracture;
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -23,6 +26,7 @@ use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, Substeps, TimeSettings};
 use crate::solver::systems::{Body, BoundaryMaterial, ElasticSolid, SolidInit};
 use std::collections::BTreeMap;
+use std::path::Path;
 
 /// The parameters of a structure in a fluid with defaults `d` (the fluid's and the common
 /// ones come from the scene): its material and scheme, and its sub-steps.
@@ -344,5 +348,47 @@ impl Watch {
         self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
         self.fracture = serde_json::from_value(state["fracture"].clone()).map_err(bad)?;
         Ok(())
+    }
+}
+
+/// A run of a water column and a structure in a tank followed by a [`Watch`]: the scene of
+/// the dam break onto a plate and of the elastic gate, which differ only in how they are
+/// built. Its time series is the watch's, its metrics the watch's against `published`.
+pub struct StructureRun {
+    /// The simulation.
+    pub sim: Simulation<2>,
+    /// What is followed.
+    pub watch: Watch,
+    /// The published curves the metrics measure the run against.
+    pub published: Vec<Published<'static>>,
+    /// How the structure is held, for the run's plan (`the plate clamped through the floor`).
+    pub held: &'static str,
+}
+
+impl SceneRun for StructureRun {
+    forward_to_sim!();
+    fn plan(&self) -> String {
+        let (_, n) = self.sim.step_sizes();
+        let body = self.watch.body;
+        plan(
+            &self.sim,
+            &format!("{LAYERS} wall layers, open top; {}; {n} {body} steps per fluid step", self.held),
+        )
+    }
+    fn sample(&mut self) -> Vec<(&'static str, f64)> {
+        self.watch.sample(&self.sim)
+    }
+    fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
+        snapshot_bodies(&self.sim, dir, index, surface_fields(&self.sim))
+    }
+    fn metrics(&self) -> BTreeMap<String, f64> {
+        self.watch.metrics(&self.sim, &self.published)
+    }
+    fn save_state(&self) -> serde_json::Value {
+        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
+    }
+    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
+        self.watch.load(&state["watch"])?;
+        restore_sim(&mut self.sim, &state)
     }
 }

@@ -250,7 +250,7 @@ mod tests {
     use super::*;
 
     /// A plate under still water without gravity carries no load: every force across the
-    /// interface balances, and after a hundred water steps (8200 plate steps) neither the
+    /// interface balances, and after a hundred water steps (7500 plate steps) neither the
     /// plate nor the water has moved.
     #[test]
     fn a_plate_under_still_water_without_load_stays_at_rest() {
