@@ -5,8 +5,8 @@
 
 use super::expand::{check_param, resolve_raw, Expand, Raw};
 use super::model::{
-    glob_matches, valid_name, Bound, Case, ClaimTest, Figure, FigureKind, ItemInfo, Select, Table, Test,
-    DEFAULT_PRESET,
+    glob_matches, is_word, valid_name, Bound, Case, ClaimTest, Figure, FigureKind, ItemInfo, Select, Table,
+    Test, DEFAULT_PRESET,
 };
 use super::reference;
 use super::schema::{BoundFile, ClaimFile, FigureFile, Loc, RawParams, Span, TableFile};
@@ -111,6 +111,7 @@ impl Expand<'_> {
             ("time", f.time.is_some(), "particles"),
             ("arrows", f.arrows.is_some(), "particles"),
             ("x_spacing", f.x_spacing, "trade"),
+            ("above_max", f.above_max.is_some(), "stability"),
         ] {
             if set && f.kind != only {
                 return Err(loc.err(span, &format!("{key}.{k}"), format!("only kind `{only}` takes `{k}`")));
@@ -191,7 +192,18 @@ impl Expand<'_> {
                 }
                 let max =
                     f.max.ok_or_else(|| self.loc.err(span.clone(), key, "kind `stability` needs `max`"))?;
-                FigureKind::Stability { x, max }
+                let above = match f.above_max.as_deref() {
+                    None => "inaccurate".to_string(),
+                    Some(w) if is_word(w) => w.to_string(),
+                    Some(w) => return Err(self.loc.err(
+                        span.clone(),
+                        &format!("{key}.above_max"),
+                        format!(
+                            "`{w}` must be a short word or two (letters, spaces, `-`; at most 24 characters)"
+                        ),
+                    )),
+                };
+                FigureKind::Stability { x, max, above }
             }
             "profile" => {
                 let file_name = need("file", &f.file)?;
@@ -655,6 +667,12 @@ mod tests {
         let e = p(&kind("stability", "\nx = \"nx\"")).unwrap_err();
         assert!(e.contains("kind `stability` needs `max`"), "{e}");
         assert!(p(&kind("stability", "\nx = \"nx\"\nmax = 0.1")).is_ok());
+        // A map's own word for a case beyond `max`: a short word, and on maps only.
+        assert!(p(&kind("stability", "\nx = \"nx\"\nmax = 0.1\nabove_max = \"water lost\"")).is_ok());
+        let e = p(&kind("stability", "\nx = \"nx\"\nmax = 0.1\nabove_max = \"<b>\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.above_max`") && e.contains("`<b>` must be a short word"), "{e}");
+        let e = p(&kind("trade", "\nx = \"nx\"\nabove_max = \"lost\"")).unwrap_err();
+        assert!(e.contains("only kind `stability` takes `above_max`"), "{e}");
         // Two cases in one cell of the map (nx = 16: SPST and EDAC, no `label` to part them).
         let e = p(&kind("stability", "\nx = \"nx\"\nmax = 0.1").replace("cases = [\"sun-*\"]\n", ""))
             .unwrap_err();

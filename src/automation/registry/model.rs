@@ -104,6 +104,9 @@ pub enum FigureKind {
         x: String,
         /// Above this value of the metric a case that completed is inaccurate.
         max: f64,
+        /// The word for such a case in this map (`above_max`, default "inaccurate"): what
+        /// exceeding `max` means, e.g. "fractured" for a count of clusters.
+        above: String,
     },
     /// Column `y` against column `x` of a CSV file in each case folder (e.g. a velocity
     /// profile written at the end of the run), one curve per case, with optional
@@ -357,4 +360,12 @@ impl std::fmt::Debug for Problem {
 /// folder: letters, digits, `.`, `_` and `-` only (no path).
 pub(super) fn valid_name(s: &str) -> bool {
     !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || matches!(c, '.' | '_' | '-'))
+}
+
+/// Whether `s` may stand in a map's key and its tables for an outcome: a short word or two
+/// (letters, spaces and `-`, at most 24 characters, starting with a letter).
+pub(super) fn is_word(s: &str) -> bool {
+    s.len() <= 24
+        && s.starts_with(|c: char| c.is_ascii_alphabetic())
+        && s.chars().all(|c| c.is_ascii_alphabetic() || matches!(c, ' ' | '-'))
 }

@@ -106,6 +106,8 @@ pub(super) struct FigureFile {
     #[serde(default)]
     pub(super) x_spacing: bool,
     #[serde(default)]
+    pub(super) above_max: Option<String>,
+    #[serde(default)]
     pub(super) file: Option<String>,
     #[serde(default)]
     pub(super) x_label: Option<String>,

@@ -34,10 +34,11 @@ impl Outcome {
         }
     }
 
-    fn name(self) -> &'static str {
+    /// The key's word, `above` for a case beyond the map's bound.
+    fn name(self, above: &str) -> &str {
         match self {
             Outcome::Stable => "stable",
-            Outcome::Inaccurate => "inaccurate",
+            Outcome::Inaccurate => above,
             Outcome::Diverged => "diverged",
             Outcome::Missing => "missing",
         }
@@ -59,6 +60,8 @@ pub struct OutcomeMap {
     pub y_ticks: Vec<String>,
     /// `(column, row, outcome, short text)`; cells out of the grid are ignored.
     pub cells: Vec<(usize, usize, Outcome, Option<String>)>,
+    /// The key's word for [`Outcome::Inaccurate`] (e.g. "fractured").
+    pub above: String,
 }
 
 /// Writes `m` to `<stem>.png` and `<stem>.svg`: coloured cells (green stable, orange
@@ -107,7 +110,8 @@ impl Render for OutcomeMap {
         });
         chart.draw_series(labels).map_err(|e| e.to_string())?;
 
-        let entries: Vec<(&str, RGBColor)> = Outcome::ALL.iter().map(|o| (o.name(), o.color())).collect();
+        let entries: Vec<(&str, RGBColor)> =
+            Outcome::ALL.iter().map(|o| (o.name(&self.above), o.color())).collect();
         canvas::key(&key, &entries, MARGIN as i32 + 10)
     }
 }
@@ -136,6 +140,7 @@ mod tests {
                 (3, 2, Outcome::Stable, None),
                 (9, 9, Outcome::Stable, None),
             ],
+            above: "fractured".into(),
         };
         outcome_map(&m, &stem).unwrap();
         let size = m.size();
@@ -146,7 +151,7 @@ mod tests {
             &[
                 "Stability, Taylor-Green Re = 100",
                 "stable",
-                "inaccurate",
+                "fractured",
                 "diverged",
                 "missing",
                 "CTVF",

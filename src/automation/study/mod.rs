@@ -337,7 +337,7 @@ fn prepare(
     tables: &Path,
 ) -> Result<Prepared, String> {
     let rs = runs(output, p, &f.select);
-    if let FigureKind::Stability { x, max } = &f.kind {
+    if let FigureKind::Stability { x, max, above } = &f.kind {
         // Every preset with results, for the table of first failures.
         let mut by_preset = Vec::new();
         for (name, cases) in p.presets() {
@@ -347,8 +347,15 @@ fn prepare(
                 by_preset.push((name.to_string(), r));
             }
         }
+        let metric = f.metric.as_deref().expect("validated");
+        let rule = stability::Rule { x, metric, max: *max, above };
         return Ok(Prepared::Drawn(stability::stability(
-            f, &rs, &by_preset, x, *max, figures, tables, &p.preset,
+            f,
+            &rule,
+            &rs,
+            &by_preset,
+            (figures, tables),
+            &p.preset,
         )?));
     }
     if rs.iter().all(|r| r.summary.is_none()) {

@@ -27,10 +27,11 @@ pub(super) fn outcome(r: &Run, m: &str, max: f64) -> (Outcome, String) {
     }
 }
 
-fn word(o: Outcome) -> &'static str {
+/// Outcome `o` in words, `above` naming a completed case whose metric exceeds the map's `max`.
+fn word(o: Outcome, above: &str) -> &str {
     match o {
         Outcome::Stable => "stable",
-        Outcome::Inaccurate => "inaccurate",
+        Outcome::Inaccurate => above,
         Outcome::Diverged => "diverged",
         Outcome::Missing => "no result",
     }
@@ -38,7 +39,7 @@ fn word(o: Outcome) -> &'static str {
 
 /// The outcomes of one scheme along the swept parameter (ascending), in words: runs of one
 /// outcome, the first `up to` its last value, the last `from` its first.
-pub(crate) fn along(cells: &[(String, Outcome)]) -> String {
+pub(crate) fn along(cells: &[(String, Outcome)], above: &str) -> String {
     let mut runs: Vec<(Outcome, Vec<&str>)> = Vec::new();
     for (x, o) in cells {
         match runs.last_mut() {
@@ -53,10 +54,10 @@ pub(crate) fn along(cells: &[(String, Outcome)]) -> String {
             let (first, last) = (xs[0], xs[xs.len() - 1]);
             let span = if xs.len() == 1 { first.to_string() } else { format!("{first} to {last}") };
             match (i, n) {
-                (_, 1) => format!("{} at every value ({span})", word(*o)),
-                (0, _) => format!("{} up to {last}", word(*o)),
-                (i, n) if i == n - 1 => format!("{} from {first}", word(*o)),
-                _ => format!("{} at {span}", word(*o)),
+                (_, 1) => format!("{} at every value ({span})", word(*o, above)),
+                (0, _) => format!("{} up to {last}", word(*o, above)),
+                (i, n) if i == n - 1 => format!("{} from {first}", word(*o, above)),
+                _ => format!("{} at {span}", word(*o, above)),
             }
         })
         .collect::<Vec<_>>()
@@ -65,9 +66,9 @@ pub(crate) fn along(cells: &[(String, Outcome)]) -> String {
 
 /// The first value along the swept parameter (ascending) where a scheme is not stable, in
 /// words (`diverged at 1`, or `none up to 2`).
-pub(crate) fn first_failure(cells: &[(String, Outcome)]) -> String {
+pub(crate) fn first_failure(cells: &[(String, Outcome)], above: &str) -> String {
     match cells.iter().find(|(_, o)| matches!(o, Outcome::Diverged | Outcome::Inaccurate)) {
-        Some((x, o)) => format!("{} at {x}", word(*o)),
+        Some((x, o)) => format!("{} at {x}", word(*o, above)),
         None => match cells.last() {
             Some((x, _)) if cells.iter().all(|(_, o)| *o == Outcome::Stable) => format!("none up to {x}"),
             _ => "-".into(),
@@ -75,24 +76,30 @@ pub(crate) fn first_failure(cells: &[(String, Outcome)]) -> String {
     }
 }
 
-/// The map, the per-case table and the first-failure table of figure `f` over `x`, for the
+/// What a stability map judges: its swept parameter `x`, and a completed case whose
+/// `metric` is above `max` is named `above` ("inaccurate", "fractured", ...).
+pub(super) struct Rule<'a> {
+    pub x: &'a str,
+    pub metric: &'a str,
+    pub max: f64,
+    pub above: &'a str,
+}
+
+/// The map, the per-case table and the first-failure table of figure `f` by `rule`, for the
 /// runs of this preset (`rs`, drawn) and of every preset that has results (`by_preset`). If
 /// this preset (`preset`) has no result, the map and its table are not drawn, and the
 /// first-failure table says what the other presets found.
-#[allow(clippy::too_many_arguments)]
 pub(super) fn stability(
     f: &Figure,
+    rule: &Rule,
     rs: &[Run],
     by_preset: &[(String, Vec<Run>)],
-    x: &str,
-    max: f64,
-    figures: &Path,
-    tables: &Path,
+    (figures, tables): (&Path, &Path),
     preset: &str,
 ) -> Result<Drawn, String> {
-    let m = f.metric.as_deref().expect("validated");
+    let Rule { x, metric: m, max, above } = *rule;
     let caption = f.info.caption.clone();
-    let first = first_failures(f, by_preset, x, m, max, tables)?;
+    let first = first_failures(f, rule, by_preset, tables)?;
     if rs.iter().all(|r| r.summary.is_none()) {
         let mut blocks = vec![Block::Missing {
             caption,
@@ -123,9 +130,9 @@ pub(super) fn stability(
         let g = group(r.case, &f.label);
         let iy = ys.iter().position(|a| *a == g).expect("listed");
         let (o, why) = outcome(r, m, max);
-        *counts.entry(word(o)).or_default() += 1;
+        *counts.entry(word(o, above)).or_default() += 1;
         cells.push((ix, iy, o, None));
-        rows.push(vec![g, xs[ix].1.clone(), word(o).to_string(), why]);
+        rows.push(vec![g, xs[ix].1.clone(), word(o, above).to_string(), why]);
     }
     report::outcome_map(
         &report::OutcomeMap {
@@ -135,12 +142,13 @@ pub(super) fn stability(
             x_ticks: xs.iter().map(|a| a.1.clone()).collect(),
             y_ticks: ys,
             cells,
+            above: above.to_string(),
         },
         &figures.join(&f.id),
     )?;
     report::write_table(
         &report::Table {
-            title: format!("{}: outcome per case (inaccurate: {m} > {max})", f.title),
+            title: format!("{}: outcome per case ({above}: {m} > {max})", f.title),
             headers: vec!["scheme".into(), x.into(), "outcome".into(), "detail".into()],
             rows,
         },
@@ -150,7 +158,7 @@ pub(super) fn stability(
         path: format!("figures/{}.png", f.id),
         caption: caption.clone(),
         ours: format!(
-            "{} (inaccurate: `{m}` > {}).",
+            "{} ({above}: `{m}` > {}).",
             counts.iter().map(|(k, v)| format!("{v} {k}")).collect::<Vec<_>>().join(", "),
             fmt_bound(max)
         ),
@@ -167,12 +175,11 @@ pub(super) fn stability(
 /// (none if no preset has one).
 fn first_failures(
     f: &Figure,
+    rule: &Rule,
     by_preset: &[(String, Vec<Run>)],
-    x: &str,
-    m: &str,
-    max: f64,
     tables: &Path,
 ) -> Result<Option<Block>, String> {
+    let Rule { x, metric: m, max, above } = *rule;
     if by_preset.is_empty() {
         return Ok(None);
     }
@@ -198,7 +205,7 @@ fn first_failures(
             if cells.iter().all(|(_, o)| *o == Outcome::Missing) {
                 continue;
             }
-            first.push(vec![preset.clone(), g, first_failure(&cells), along(&cells)]);
+            first.push(vec![preset.clone(), g, first_failure(&cells, above), along(&cells, above)]);
         }
     }
     let first_id = format!("{}_first_failure", f.id);
@@ -226,13 +233,16 @@ mod tests {
         use Outcome::*;
         let s =
             c(&[("0.1", Stable), ("0.25", Stable), ("0.5", Inaccurate), ("1", Diverged), ("2", Diverged)]);
-        assert_eq!(along(&s), "stable up to 0.25; inaccurate at 0.5; diverged from 1");
-        assert_eq!(first_failure(&s), "inaccurate at 0.5");
+        assert_eq!(along(&s, "inaccurate"), "stable up to 0.25; inaccurate at 0.5; diverged from 1");
+        assert_eq!(first_failure(&s, "inaccurate"), "inaccurate at 0.5");
+        // A map's own word for exceeding its bound.
+        assert_eq!(along(&s, "fractured"), "stable up to 0.25; fractured at 0.5; diverged from 1");
+        assert_eq!(first_failure(&s, "fractured"), "fractured at 0.5");
         let all = c(&[("1", Stable), ("2", Stable)]);
-        assert_eq!(along(&all), "stable at every value (1 to 2)");
-        assert_eq!(first_failure(&all), "none up to 2");
+        assert_eq!(along(&all, "inaccurate"), "stable at every value (1 to 2)");
+        assert_eq!(first_failure(&all, "inaccurate"), "none up to 2");
         let low = c(&[("0.5", Diverged), ("1", Stable)]);
-        assert_eq!(first_failure(&low), "diverged at 0.5");
-        assert_eq!(along(&low), "diverged up to 0.5; stable from 1");
+        assert_eq!(first_failure(&low, "inaccurate"), "diverged at 0.5");
+        assert_eq!(along(&low, "inaccurate"), "diverged up to 0.5; stable from 1");
     }
 }
