@@ -54,7 +54,7 @@
 use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, Extrema, SolidDefaults, SolidSetup,
+    check_count, forward_stepwise, solid_params, solid_setup, Extrema, Probe, SolidDefaults, SolidSetup,
 };
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
@@ -252,9 +252,8 @@ impl PeriodMean {
 
 struct Beam {
     sim: Simulation<2>,
-    /// The particles of the middle column(s), and their mean y at the start.
-    middle: Vec<usize>,
-    y0: f64,
+    /// The middle column(s) of the beam.
+    middle: Probe,
     /// Eq. (4.16) for the modelled beam, and the first mode's period.
     exact: f64,
     period: f64,
@@ -269,18 +268,12 @@ fn beam(p: &Params) -> Result<Beam, String> {
     let Setup { solid: SolidSetup { material, mut scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
     let (l, hb, q) = (nx as f64 * dx, ny as f64 * dx, p.float("q"));
     let columns = nx + 2 * layers;
-    // Middle column(s) of the beam, counted from its first free column.
-    let mid: Vec<usize> = if nx % 2 == 1 { vec![nx / 2] } else { vec![nx / 2 - 1, nx / 2] };
     let mut init = SolidInit::<2>::default();
-    let mut middle = Vec::new();
     for j in 0..ny {
         let y = (j as f64 + 0.5) * dx - 0.5 * hb;
         for i in 0..columns {
             // Columns 0..layers and the last `layers` are the clamps; the beam spans x = 0..l.
             let x = (i as f64 - layers as f64 + 0.5) * dx;
-            if i >= layers && mid.contains(&(i - layers)) {
-                middle.push(init.x.len());
-            }
             init.x.push(Vector::<2>::new(x, y));
             init.u.push(Vector::<2>::zeros());
             init.m.push(material.rho0 * dx * dx);
@@ -303,6 +296,8 @@ fn beam(p: &Params) -> Result<Beam, String> {
         _ => scheme.gravity = [0.0, -g, 0.0],
     }
     let solid = ElasticSolid::new(BEAM, h, init, material, scheme)?;
+    // The middle column (nx odd, at x = L/2) or the two middle columns (nx even, at L/2 ± dx/2).
+    let middle = Probe::new(&solid, "mid-span", |x| (x[0] - 0.5 * l).abs() < 0.75 * dx)?;
     let margin = (layers as f64 + 4.0) * dx;
     let domain = Domain::bounded([-margin, -hb - margin], [l + margin, hb + margin]);
     let sim = simulation("clamped_beam_udl", p, domain, kernel, [solid.into()])?;
@@ -311,12 +306,10 @@ fn beam(p: &Params) -> Result<Beam, String> {
     let mut run = Beam {
         sim,
         middle,
-        y0: 0.0,
         exact,
         period: first_mode_period(&material, l, hb),
         mean: PeriodMean::new((1.0 - WINDOW) * tf, HYSTERESIS * exact.abs()),
     };
-    run.y0 = run.middle_y();
     run.mean.push(0.0, 0.0);
     Ok(run)
 }
@@ -326,14 +319,13 @@ impl Beam {
         self.sim.solid(BEAM).expect("the beam").0
     }
 
-    /// The mean y of the middle column(s).
-    fn middle_y(&self) -> f64 {
-        let s = self.solid();
-        self.middle.iter().map(|&i| s.x[i][1]).sum::<f64>() / self.middle.len() as f64
+    /// The vertical displacement of the middle column(s).
+    fn midspan_y(&self) -> f64 {
+        self.middle.displacement(self.solid())[1]
     }
 
     fn after_step(&mut self) {
-        let (t, y) = (self.sim.time(), self.middle_y() - self.y0);
+        let (t, y) = (self.sim.time(), self.midspan_y());
         self.mean.push(t, y);
     }
 }
@@ -346,16 +338,12 @@ impl SceneRun for Beam {
             &format!(
                 "clamps of {} fixed particles at both ends; mid-span: {} particles",
                 self.solid().fixed.iter().filter(|&&f| f).count(),
-                self.middle.len()
+                self.middle.count()
             ),
         )
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
-        vec![
-            ("t", self.sim.time()),
-            ("midspan_y", self.middle_y() - self.y0),
-            ("midspan_y_exact", self.exact),
-        ]
+        vec![("t", self.sim.time()), ("midspan_y", self.midspan_y()), ("midspan_y_exact", self.exact)]
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
         snapshot_bodies(&self.sim, dir, index, Vec::new())

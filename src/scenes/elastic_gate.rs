@@ -31,9 +31,10 @@
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
 use super::common::{free_surface_params, scheme_params, wall_params};
-use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, Probe, StructureRun, Watch};
+use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, StructureRun, Watch};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
+use super::solid_common::Probe;
 use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};

@@ -13,7 +13,7 @@ use super::common::{
 };
 use super::params::{Params, Spec};
 use super::solid_common::{
-    check_count, solid_params_as, solid_setup_as, SolidDefaults, SolidSetup, STRUCTURE,
+    check_count, solid_params_as, solid_setup_as, Probe, SolidDefaults, SolidSetup, STRUCTURE,
 };
 use super::tank::LAYERS;
 use super::tank::{Column, RHO0};
@@ -195,43 +195,6 @@ pub fn fluid_inside(sim: &Simulation<2>, name: &str, dx: f64) -> usize {
 pub fn fluid_outside(sim: &Simulation<2>, tank_width: f64, dx: f64) -> usize {
     let depth = super::tank::LAYERS as f64 * dx;
     sim.fluid().x.iter().filter(|x| x[0] < -depth || x[0] > tank_width + depth || x[1] < -depth).count()
-}
-
-/// A point of a structure followed over a run: the mean position of some of its particles,
-/// and its displacement from where it started.
-#[derive(Clone, Debug)]
-pub struct Probe {
-    indices: Vec<usize>,
-    start: Vector<2>,
-}
-
-impl Probe {
-    /// The mean of the free particles of `solid` at which `pick` holds (`what` names them in
-    /// the error when there are none).
-    pub fn new(
-        solid: &ElasticSolid<2>,
-        what: &str,
-        pick: impl Fn(&Vector<2>) -> bool,
-    ) -> Result<Self, String> {
-        let indices: Vec<usize> =
-            (0..solid.len()).filter(|&i| !solid.fixed[i] && pick(&solid.x[i])).collect();
-        if indices.is_empty() {
-            return Err(format!("solid `{}`: no particle at {what}", solid.name));
-        }
-        let mut probe = Self { indices, start: Vector::zeros() };
-        probe.start = probe.position(solid);
-        Ok(probe)
-    }
-
-    /// The mean position of the particles now.
-    pub fn position(&self, solid: &ElasticSolid<2>) -> Vector<2> {
-        self.indices.iter().map(|&i| solid.x[i]).sum::<Vector<2>>() / self.indices.len() as f64
-    }
-
-    /// The displacement from the start.
-    pub fn displacement(&self, solid: &ElasticSolid<2>) -> Vector<2> {
-        self.position(solid) - self.start
-    }
 }
 
 /// The points `(t, value)` of the CSV `text` (a header row, then rows) whose column

@@ -35,9 +35,10 @@ use super::common::{
     forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
     wall_params,
 };
-use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, structure_params, FsiSetup, Probe};
+use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, structure_params, FsiSetup};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
+use super::solid_common::Probe;
 use super::solid_common::{check_count, SolidDefaults};
 use super::tank::{Column, LAYERS, RHO0};
 use super::{common_params, SceneEntry, SceneRun};

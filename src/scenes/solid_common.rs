@@ -7,8 +7,9 @@
 
 use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
+use crate::solver::math::Vector;
 use crate::solver::scheme::{Pst, SolidScheme, SolidSchemeName, SolidSettings};
-use crate::solver::systems::SolidMaterial;
+use crate::solver::systems::{ElasticSolid, SolidMaterial};
 use serde::{Deserialize, Serialize};
 
 /// The most steps a run may need (as the fluid scenes' bound).
@@ -326,6 +327,48 @@ macro_rules! forward_stepwise {
     };
 }
 pub(crate) use forward_stepwise;
+
+/// A point of a solid followed over a run: the mean position of some of its particles,
+/// and its displacement from where it started.
+#[derive(Clone, Debug)]
+pub struct Probe {
+    indices: Vec<usize>,
+    start: Vector<2>,
+}
+
+impl Probe {
+    /// The mean of the free particles of `solid` at which `pick` holds (`what` names them in
+    /// the error when there are none).
+    pub fn new(
+        solid: &ElasticSolid<2>,
+        what: &str,
+        pick: impl Fn(&Vector<2>) -> bool,
+    ) -> Result<Self, String> {
+        let indices: Vec<usize> =
+            (0..solid.len()).filter(|&i| !solid.fixed[i] && pick(&solid.x[i])).collect();
+        if indices.is_empty() {
+            return Err(format!("solid `{}`: no particle at {what}", solid.name));
+        }
+        let mut probe = Self { indices, start: Vector::zeros() };
+        probe.start = probe.position(solid);
+        Ok(probe)
+    }
+
+    /// How many particles it follows.
+    pub fn count(&self) -> usize {
+        self.indices.len()
+    }
+
+    /// The mean position of the particles now.
+    pub fn position(&self, solid: &ElasticSolid<2>) -> Vector<2> {
+        self.indices.iter().map(|&i| solid.x[i]).sum::<Vector<2>>() / self.indices.len() as f64
+    }
+
+    /// The displacement from the start.
+    pub fn displacement(&self, solid: &ElasticSolid<2>) -> Vector<2> {
+        self.position(solid) - self.start
+    }
+}
 
 #[cfg(test)]
 mod tests {

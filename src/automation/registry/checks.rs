@@ -195,13 +195,15 @@ impl Expand<'_> {
                 let above = match f.above_max.as_deref() {
                     None => "inaccurate".to_string(),
                     Some(w) if is_word(w) => w.to_string(),
-                    Some(w) => return Err(self.loc.err(
-                        span.clone(),
-                        &format!("{key}.above_max"),
-                        format!(
+                    Some(w) => {
+                        return Err(self.loc.err(
+                            span.clone(),
+                            &format!("{key}.above_max"),
+                            format!(
                             "`{w}` must be a short word or two (letters, spaces, `-`; at most 24 characters)"
                         ),
-                    )),
+                        ))
+                    }
                 };
                 FigureKind::Stability { x, max, above }
             }
