@@ -247,11 +247,21 @@ struct BenchArgs {
     /// the resident growth while each simulation was built.
     #[arg(long, value_name = "ROUNDS", conflicts_with_all = ["repeat", "peer"], value_parser = clap::value_parser!(u32).range(2..))]
     interleave: Option<u32>,
+    /// Time a registered scene (`list`) instead of the Taylor-Green variants: its
+    /// particle-steps per second and memory at each of --bench-threads, with its parameters
+    /// from --set (its defaults otherwise), e.g. `--scene dam_break_elastic_plate --set
+    /// dx=0.0005`. A step is a step of the scene's time loop, a structure's sub-steps inside it.
+    #[arg(long, conflicts_with_all = ["nx", "variants", "peer", "kernel", "interleave"])]
+    scene: Option<String>,
+    /// A parameter of --scene, as key=value (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE", requires = "scene")]
+    sets: Vec<String>,
 }
 
 impl BenchArgs {
     fn options(self) -> bench::Options {
-        let BenchArgs { nx, bench_threads, variants, steps, repeat, json, peer, kernel, interleave } = self;
+        let BenchArgs { nx, bench_threads, variants, steps, repeat, json, peer, kernel, interleave, .. } =
+            self;
         bench::Options { nx, threads: bench_threads, variants, steps, repeat, json, peer, kernel, interleave }
     }
 }
@@ -341,7 +351,8 @@ enum Command {
         #[arg(long)]
         index: Option<usize>,
     },
-    /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst.
+    /// Throughput and memory of Taylor-Green for edac, ctvf+sun, ctvf+ipst, or of any scene
+    /// (--scene).
     Bench(BenchArgs),
     /// One benchmark configuration in this process (used by `bench`).
     #[command(hide = true)]
@@ -371,6 +382,16 @@ enum Command {
         rounds: u32,
         #[arg(long, default_value = bench::DEFAULT_KERNEL)]
         kernel: String,
+    },
+    /// One run of a scene timed in this process (used by `bench --scene`).
+    #[command(hide = true)]
+    BenchScene {
+        #[arg(long)]
+        scene: String,
+        #[arg(long = "set")]
+        sets: Vec<String>,
+        #[arg(long)]
+        steps: Option<u64>,
     },
 }
 
@@ -484,7 +505,18 @@ fn run(cli: Cli) -> u8 {
             lock_fd,
             harness::RunOptions { quiet, force, progress_file, checkpoint_every, stop_after_steps },
         ),
-        Command::Bench(args) => bench::run(&args.options()),
+        Command::Bench(args) => match &args.scene {
+            Some(scene) => bench::run_scene(&bench::SceneOptions {
+                scene,
+                sets: &args.sets,
+                threads: &args.bench_threads,
+                steps: args.steps,
+                repeat: args.repeat,
+                json: &args.json,
+            }),
+            None => bench::run(&args.options()),
+        },
+        Command::BenchScene { scene, sets, steps } => bench::scene_child(&scene, &sets, steps),
         Command::BenchCase { variant, nx, steps, kernel } => bench::case_child(&variant, nx, steps, &kernel),
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => {
             bench::interleaved_child(&variants, nx, &bench_threads, steps, rounds, &kernel)

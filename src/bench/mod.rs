@@ -12,13 +12,15 @@
 //! - `stats`: median runs and round-by-round ratios with their confidence interval;
 //! - `peer`: the peer code's runs and our accuracy on them;
 //! - `report`: the Markdown table and what is printed;
-//! - `targets`: the throughput targets and whether the runs meet them.
+//! - `targets`: the throughput targets and whether the runs meet them;
+//! - `scene`: `bench --scene`, any registered scene at its parameters, per thread count.
 
 mod case;
 mod peer;
 mod process;
 mod report;
 mod run;
+mod scene;
 mod stats;
 mod targets;
 mod timing;
@@ -26,6 +28,7 @@ mod timing;
 pub use case::DEFAULT_KERNEL;
 pub use process::{case_child, interleaved_child};
 pub use run::{run, Options};
+pub use scene::{run_scene, scene_child, SceneOptions};
 
 #[cfg(test)]
 mod testutil;

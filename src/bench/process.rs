@@ -8,7 +8,7 @@ use super::timing::{run_case, run_interleaved};
 use std::path::Path;
 
 /// Runs the hidden bench subcommand `args` in a child process and reads its JSON result.
-fn bench_child<T: serde::de::DeserializeOwned>(exe: &Path, args: &[&str]) -> Result<T, String> {
+pub(super) fn bench_child<T: serde::de::DeserializeOwned>(exe: &Path, args: &[&str]) -> Result<T, String> {
     let o = std::process::Command::new(exe)
         .args(args)
         .output()
@@ -103,7 +103,7 @@ pub fn interleaved_child(
 }
 
 /// A child's result as one JSON line on stdout (exit code 0), or its error on stderr (1).
-fn print_json(r: Result<impl serde::Serialize, String>) -> u8 {
+pub(super) fn print_json(r: Result<impl serde::Serialize, String>) -> u8 {
     match r {
         Ok(r) => {
             crate::outln!("{}", serde_json::to_string(&r).expect("serialises"));

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 /// A `/proc/self/status` field in kB (`VmRSS:` now, `VmHWM:` the peak), 0 where there is
 /// none.
-fn status_kb(field: &str) -> u64 {
+pub(super) fn status_kb(field: &str) -> u64 {
     std::fs::read_to_string("/proc/self/status")
         .ok()
         .and_then(|s| {
