@@ -204,25 +204,41 @@ fn published(source: &str) -> Vec<(f64, f64)> {
 mod tests {
     use super::*;
 
-    /// The coarse dam break (3 particles across the plate) through the impact: at every
-    /// hundredth of a second to t = 0.2 s no water is inside the plate or beyond the walls.
-    #[test]
-    fn the_water_stays_out_of_the_plate_through_the_impact() {
+    /// The coarse dam break (dx = 4 mm, 3 particles across the plate) with `solid_pst`
+    /// in the plate to `tf`: at every hundredth of a second no water is inside the plate or
+    /// beyond the walls; the tip has moved.
+    fn water_stays_out(solid_pst: &str, tf: f64) {
         let specs = params();
         let mut p = Params::defaults(&specs);
-        for (key, value) in [("dx", "0.004"), ("tf", "0.2")] {
+        for (key, value) in [("dx", "0.004"), ("tf", &tf.to_string()), ("solid_pst", solid_pst)] {
             p.set_str("dam_break_elastic_plate", &specs, key, value).unwrap();
         }
         let mut run = impact(&p).unwrap();
         let mut t = 0.0;
-        while t < 0.2 - 1e-9 {
+        while t < tf - 1e-9 {
             t += 0.01;
-            run.sim.advance(t, 0.2, |_| true).unwrap();
+            run.sim.advance(t, tf, |_| true).unwrap();
             run.sample();
             assert_eq!(run.watch.metrics(&run.sim, &[])["particles_lost"], 0.0, "water lost by t = {t}");
         }
-        let tip = run.watch.samples.last().unwrap().1;
-        assert!(tip > 0.005, "the water has pushed the plate's tip by {tip} m at t = 0.2 s");
+        let tip = run.watch.samples.iter().map(|s| s.1).fold(0.0, f64::max);
+        assert!(tip > 0.005, "the water has pushed the plate's tip by at most {tip} m");
+    }
+
+    /// With IPST in the plate (the thesis's choice), through the impact (to t = 0.2 s, the
+    /// plate's largest bend). Later in the quick preset's run, at this spacing, the plate's
+    /// foot slides about one spacing over its clamp and one water particle follows it into
+    /// the gap (the same without shifting in the plate): the problem's bound reports it.
+    #[test]
+    fn the_water_stays_out_of_the_plate_through_the_impact() {
+        water_stays_out("ipst", 0.2);
+    }
+
+    /// With Sun's shifting in the plate, over the quick preset's whole run (t = 0.4 s: the
+    /// impact, the plate's return and the water coming back from the far wall).
+    #[test]
+    fn with_sun_shifting_the_water_stays_out_to_the_end() {
+        water_stays_out("sun", 0.4);
     }
 
     /// Bad input is refused with its key named.
