@@ -11,9 +11,12 @@
 //! 4.2.3), stepping `solid_substeps` times per fluid step (its sound speed, 5100 m/s, is
 //! about eighty times the water's).
 //!
-//! The plate is a lattice of `round(width / dx)` x `round(plate_thickness / dx)` particles
-//! below y = 0 (the water's floor); each clamp continues it beyond each end for as many
-//! columns as the kernel's support reaches, fixed, directly below the side walls.
+//! The plate is a lattice of n = `round(width / dx)` x `round(plate_thickness / dx)`
+//! particles below y = 0 (the water's floor), n dx wide as the water column and the tank
+//! are; each clamp continues it beyond each end for as many columns as the kernel's support
+//! reaches, fixed, directly below the side walls. Where `dx` does not divide `width`, the
+//! modelled plate is n dx wide (the right clamp starts there, on the lattice, not at
+//! `width`), so that no column of the plate is closer to its clamp or farther from it than dx.
 //!
 //! The static deflection (eq. 4.16 with the plate's rigidity, D = E t^3 / (12 (1 - nu^2))):
 //! a plate clamped at both ends under the uniform load of the water's weight and its own,
@@ -63,7 +66,8 @@ pub const ENTRY: SceneEntry = SceneEntry {
     check: |p| setup(p).map(drop),
     metrics: &["midspan_deflection", "deflection_rel_error", "pressure_rel_error", "particles_lost"],
     columns: &["t", "midspan_y", "max_speed"],
-    outputs: 0,
+    // 1: the right clamp on the lattice where `dx` does not divide `width`.
+    outputs: 1,
 };
 
 fn params() -> Vec<Spec> {
@@ -170,12 +174,14 @@ fn plate(p: &Params) -> Result<HydrostaticPlate, String> {
     // The plate is the floor: the tank keeps its side walls only.
     let (fluid, wall) = column.bodies_without(p, (s.h, s.constants.c0, s.fluid, g), |x| x[1] < 0.0)?;
     let clamp = s.solid.support_layers() as f64 * dx;
-    let free = lattice(0.0, w, -t, 0.0, dx);
+    // The modelled width, on the lattice of the water and the walls (module docs).
+    let wm = (w / dx).round() * dx;
+    let free = lattice(0.0, wm, -t, 0.0, dx);
     let mut fixed = lattice(-clamp, 0.0, -t, 0.0, dx);
-    fixed.extend(lattice(w, w + clamp, -t, 0.0, dx));
+    fixed.extend(lattice(wm, wm + clamp, -t, 0.0, dx));
     let what = format!("`dx` = {dx} (`width` = {w}, `plate_thickness` = {t})");
     let plate = s.structure(("hydrostatic_plate", &what), PLATE, free, fixed, p)?;
-    let middle = Probe::new(&plate, "mid-span", |x| (x[0] - 0.5 * w).abs() < dx)?;
+    let middle = Probe::new(&plate, "mid-span", |x| (x[0] - 0.5 * wm).abs() < dx)?;
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-edge, -t - edge], [w + edge, p.float("tank_height") + edge]);
     let sim = s.simulation("hydrostatic_plate", p, domain, [fluid.into(), wall.into(), plate.into()])?;
@@ -269,6 +275,34 @@ mod tests {
         let moved = plate.x.iter().zip(&x0).map(|(x, y)| (x - y).norm()).fold(0.0, f64::max);
         assert!(moved < 1e-12 && plate.max_speed() < 1e-12, "the plate moved {moved} m");
         assert!(run.sim.max_speed() < 1e-12, "the water moves at {}", run.sim.max_speed());
+    }
+
+    /// Where `dx` does not divide the width (1 m / 0.0167 m = 59.9), the plate and its clamps
+    /// are one lattice of spacing dx from end to end, and the side walls stand on the clamps'
+    /// columns: no gap or overlap at a clamp.
+    #[test]
+    fn the_clamps_continue_the_plate_lattice_at_any_spacing() {
+        let specs = params();
+        let mut p = Params::defaults(&specs);
+        let dx = 0.0167;
+        p.set_str("hydrostatic_plate", &specs, "dx", &dx.to_string()).unwrap();
+        let run = plate(&p).unwrap();
+        let (plate, _) = run.sim.solid(PLATE).unwrap();
+        let row = |y: f64| {
+            let mut xs: Vec<f64> =
+                plate.x.iter().filter(|x| (x[1] - y).abs() < 0.25 * dx).map(|x| x[0]).collect();
+            xs.sort_by(f64::total_cmp);
+            xs
+        };
+        let xs = row(-0.5 * dx);
+        let gaps = xs.windows(2).map(|w| w[1] - w[0]);
+        assert!(gaps.clone().all(|g| (g - dx).abs() < 1e-9), "{:?}", gaps.collect::<Vec<_>>());
+        // The walls' columns beside the water are the clamps' columns.
+        let wall = run.sim.walls().next().expect("the side walls");
+        let right_wall: Vec<f64> = wall.x.iter().filter(|x| x[0] > 0.5).map(|x| x[0]).collect();
+        for x in right_wall {
+            assert!(xs.iter().any(|c| (c - x).abs() < 1e-9), "a wall column at x = {x} stands on no clamp column");
+        }
     }
 
     /// The defaults' static deflection is the thesis's -6.85e-5 m to its rounding (its

@@ -91,9 +91,10 @@ pub struct SceneEntry {
     /// The columns of `timeseries.csv`, in order (problem files' figures are checked
     /// against them before anything runs).
     pub columns: &'static [&'static str],
-    /// Version of what the scene reports (metrics, time-series columns): raised when one is
-    /// added, so that cached results without it are stale and rerun (it joins the cache
-    /// key; 0 adds nothing to it).
+    /// Version of what the scene reports (metrics, time-series columns) and of how it builds
+    /// its bodies: raised when a metric is added or the scene's geometry is fixed, so that
+    /// cached results of the earlier version are stale and rerun (it joins the cache key; 0
+    /// adds nothing to it).
     pub outputs: u32,
 }
 
