@@ -312,7 +312,10 @@ mod tests {
         let wall = run.sim.walls().next().expect("the side walls");
         let right_wall: Vec<f64> = wall.x.iter().filter(|x| x[0] > 0.5).map(|x| x[0]).collect();
         for x in right_wall {
-            assert!(xs.iter().any(|c| (c - x).abs() < 1e-9), "a wall column at x = {x} stands on no clamp column");
+            assert!(
+                xs.iter().any(|c| (c - x).abs() < 1e-9),
+                "a wall column at x = {x} stands on no clamp column"
+            );
         }
     }
 
