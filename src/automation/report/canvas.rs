@@ -237,19 +237,21 @@ fn title_size<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, title: &str) ->
 /// The chart type every figure draws on.
 pub(crate) type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<Axis, Axis>>;
 
+/// The room the y axis takes for category `names`: they need more than numbers (e.g.
+/// `ctvf/ipst/none`), about 0.6 em per character, plus the axis description.
+pub(crate) fn y_label_area(names: &[String]) -> u32 {
+    let chars = names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as u32;
+    Y_LABEL_AREA.max(chars * TICK_SIZE * 6 / 10 + DESC_SIZE + 25)
+}
+
 /// A chart frame in `area`: margins, label areas and the axes, nothing drawn yet.
 pub(crate) fn chart<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     x: Axis,
     y: Axis,
 ) -> Result<Chart<'_, DB>, String> {
-    // Category names (e.g. `ctvf/ipst/none`) need more room than numbers: about 0.6 em
-    // per character, plus the axis description.
     let y_area = match &y {
-        Axis::Category(names) => {
-            let chars = names.iter().map(|n| n.chars().count()).max().unwrap_or(0) as u32;
-            Y_LABEL_AREA.max(chars * TICK_SIZE * 6 / 10 + DESC_SIZE + 25)
-        }
+        Axis::Category(names) => y_label_area(names),
         _ => Y_LABEL_AREA,
     };
     ChartBuilder::on(area)

@@ -78,7 +78,9 @@ impl Render for OutcomeMap {
 
     fn size(&self) -> (u32, u32) {
         let (nx, ny) = (self.x_ticks.len() as u32, self.y_ticks.len() as u32);
-        ((330 + KEY_PANEL + 100 * nx).clamp(700, 2400), (180 + 56 * ny).clamp(360, 1600))
+        // The row names' room grows with the longest, so that the cells keep theirs.
+        let labels = canvas::y_label_area(&self.y_ticks).max(230) + 100;
+        ((labels + KEY_PANEL + 100 * nx).clamp(700, 2400), (180 + 56 * ny).clamp(360, 1600))
     }
 
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
