@@ -18,7 +18,7 @@
 
 use super::cache::{self, Entry};
 use super::registry::{FigureKind, Problem};
-use super::study::snapshot::{drawn_series, pick_snapshot, pvd_entries, pvd_text, snapshot_series};
+use super::study::snapshot::{beside, drawn_series, pick_snapshot, pvd_entries, pvd_text};
 use crate::solver::output::summary::{Status, Summary};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
@@ -146,11 +146,7 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
             let (t, file) = pick_snapshot(&list, *time).clone();
             let slot = snaps.entry(e.dir.clone()).or_insert_with(|| (dest(&e), BTreeMap::new()));
             slot.1.entry(series.clone()).or_default().insert(file);
-            // Beside the drawn series: the walls, and the structures beside a fluid.
-            for other in snapshot_series(&e.dir)? {
-                if other == series || (other != "wall.pvd" && series != "fluid.pvd") {
-                    continue;
-                }
+            for other in beside(&e.dir, &series)? {
                 let entries = pvd_entries(&e.dir, &other)?;
                 slot.1.entry(other).or_default().insert(pick_snapshot(&entries, Some(t)).1.clone());
             }

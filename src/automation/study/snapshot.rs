@@ -205,15 +205,12 @@ pub(crate) fn snapshot(
     let value = vtu.field(field)?;
     let arrows = arrows.map(|a| vtu.vectors(a)).transpose()?;
     let walls = points_at(dir, "wall.pvd", t)?;
-    // Structures in a fluid: every series besides the fluid's and the walls'.
     let mut structures: Option<Points> = None;
-    if drawn == "fluid.pvd" {
-        for name in snapshot_series(dir)?.into_iter().filter(|n| n != "fluid.pvd" && n != "wall.pvd") {
-            if let Some((x, y)) = points_at(dir, &name, t)? {
-                let s = structures.get_or_insert_with(Default::default);
-                s.0.extend(x);
-                s.1.extend(y);
-            }
+    for name in beside(dir, &drawn)?.into_iter().filter(|n| n != "wall.pvd") {
+        if let Some((x, y)) = points_at(dir, &name, t)? {
+            let s = structures.get_or_insert_with(Default::default);
+            s.0.extend(x);
+            s.1.extend(y);
         }
     }
     Ok(Some(Snapshot { x: vtu.x, y: vtu.y, value, arrows, walls, structures, t }))
@@ -237,6 +234,16 @@ fn points_at(dir: &Path, name: &str, t: f64) -> Result<Option<Points>, String> {
         }
         None => None,
     })
+}
+
+/// The series drawn beside series `drawn` of case folder `dir` (the snapshots a particle
+/// figure reads and an export keeps with it): the walls', and beside a fluid's every other
+/// body's (structures in the fluid).
+pub(crate) fn beside(dir: &Path, drawn: &str) -> Result<Vec<String>, String> {
+    Ok(snapshot_series(dir)?
+        .into_iter()
+        .filter(|n| n != drawn && (n == "wall.pvd" || drawn == "fluid.pvd"))
+        .collect())
 }
 
 /// The snapshot series (`*.pvd`) of case folder `dir`, by name.
