@@ -10,6 +10,7 @@
 
 use super::case::{default_steps, WARMUP};
 use super::process::{bench_child, print_json};
+use super::stats::median_runs;
 use super::timing::status_kb;
 use crate::scenes::{self, SceneRun};
 use crate::solver::output::summary::Provenance;
@@ -43,6 +44,10 @@ pub(super) struct SceneResult {
     pub peak_rss_bytes: u64,
     /// (peak resident memory - resident memory before the scene was built) / particles.
     pub bytes_per_particle: f64,
+    /// Particle-steps per second of every run of its thread count, in a table's median run
+    /// ([`median_runs`]); empty in the JSON's list of every run.
+    #[serde(default)]
+    pub runs: Vec<f64>,
 }
 
 /// Steps `run` `n` more steps (fewer if it reaches the scene's end time `tf` first);
@@ -93,6 +98,7 @@ pub(super) fn time_scene(
         particle_steps_per_second: particles as f64 * taken as f64 / seconds,
         peak_rss_bytes: peak * 1024,
         bytes_per_particle: peak.saturating_sub(before) as f64 * 1024.0 / particles as f64,
+        runs: Vec::new(),
     })
 }
 
@@ -181,40 +187,25 @@ pub fn run_scene(o: &SceneOptions) -> u8 {
     }
 }
 
-/// The median of `v` (the mean of the two middle values for an even count).
-fn median(v: &[f64]) -> f64 {
-    let mut s = v.to_vec();
-    s.sort_by(f64::total_cmp);
-    let n = s.len();
-    if n % 2 == 1 {
-        s[n / 2]
-    } else {
-        0.5 * (s[n / 2 - 1] + s[n / 2])
-    }
-}
-
-/// The Markdown table of `runs`: per thread count, the median run's throughput with the
-/// range over the runs, its memory, and the speed-up of its median over the fewest threads'.
+/// The Markdown table of `runs`: per thread count, the median run (as `bench` takes it for
+/// every case: [`median_runs`]) with its throughput, the range over the runs, its memory,
+/// and the speed-up of its throughput over the fewest threads'.
 fn table(runs: &[SceneResult]) -> String {
-    let mut threads: Vec<usize> = runs.iter().map(|r| r.threads).collect();
-    threads.sort_unstable();
-    threads.dedup();
+    let mut medians = median_runs(runs.to_vec());
+    medians.sort_by_key(|r| r.threads);
     let mut s = String::from(
         "| scene | particles | threads | steps | particle-steps/s (median) | range | speed-up | peak MB | bytes/particle |\n|---|---|---|---|---|---|---|---|---|\n",
     );
-    let mut base = None;
-    for t in threads {
-        let of: Vec<&SceneResult> = runs.iter().filter(|r| r.threads == t).collect();
-        let speeds: Vec<f64> = of.iter().map(|r| r.particle_steps_per_second).collect();
-        let m = median(&speeds);
-        let base = *base.get_or_insert(m);
-        let lo = speeds.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = speeds.iter().copied().fold(0.0, f64::max);
-        let r = of[0];
+    let base = medians.first().map_or(1.0, |r| r.particle_steps_per_second);
+    for r in &medians {
+        let m = r.particle_steps_per_second;
+        let lo = r.runs.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = r.runs.iter().copied().fold(0.0, f64::max);
         s += &format!(
-            "| {} | {} | {t} | {} | {m:.3e} | {lo:.3e} - {hi:.3e} | {:.2} | {:.0} | {:.0} |\n",
+            "| {} | {} | {} | {} | {m:.3e} | {lo:.3e} - {hi:.3e} | {:.2} | {:.0} | {:.0} |\n",
             r.scene,
             r.particles,
+            r.threads,
             r.steps,
             m / base,
             r.peak_rss_bytes as f64 / 1e6,
@@ -259,6 +250,7 @@ mod tests {
             particle_steps_per_second: pss,
             peak_rss_bytes: 50_000_000,
             bytes_per_particle: 1000.0,
+            runs: vec![],
         };
         let t = table(&[
             run(1, 1.0e6),
