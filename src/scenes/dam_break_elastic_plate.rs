@@ -25,11 +25,12 @@
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
 use super::common::{free_surface_params, scheme_params, wall_params};
-use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, StructureRun, Watch};
+use super::fsi_common::{
+    check_lattice, fsi_setup, lattice_words, reference_curve, structure_params, FsiSetup, StructureRun, Watch,
+};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::Probe;
-use super::solid_common::{check_count, SolidDefaults};
+use super::solid_common::{Probe, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
@@ -61,6 +62,9 @@ pub const ENTRY: SceneEntry = SceneEntry {
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
+
+/// The two lengths the structure's lattice spans, for its particle count and its errors.
+const LATTICE: (&str, &str) = ("plate_width", "plate_height");
 
 fn params() -> Vec<Spec> {
     let mut v = vec![
@@ -139,12 +143,7 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
             return bad(key, format!("the plate needs at least two particles across (dx = {dx})"));
         }
     }
-    let (pw, ph) = (p.float("plate_width"), p.float("plate_height"));
-    check_count(
-        scene,
-        &format!("`dx` = {dx} (`plate_width` = {pw}, `plate_height` = {ph})"),
-        (pw / dx) * (ph / dx),
-    )?;
+    check_lattice(scene, p, LATTICE)?;
     // The plate's tip moves at most at the surge's speed, 2 sqrt(g H).
     let u = 2.0 * (G * p.float("column_height")).sqrt();
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)
@@ -174,8 +173,8 @@ fn impact(p: &Params) -> Result<StructureRun, String> {
     let (fluid, wall) = column(p).bodies_without(p, (s.h, s.constants.c0, s.fluid, G), under_plate)?;
     let ph = p.float("plate_height");
     let free = lattice(x0, x1, 0.0, ph, dx);
-    let what = format!("`dx` = {dx} (`plate_width` = {}, `plate_height` = {ph})", p.float("plate_width"));
-    let plate = s.structure(("dam_break_elastic_plate", &what), PLATE, free, fixed, p)?;
+    let plate =
+        s.structure(("dam_break_elastic_plate", &lattice_words(p, LATTICE)), PLATE, free, fixed, p)?;
     let tip = Probe::new(&plate, "the plate's top", |x| x[1] > ph - dx)?;
     // Open above: the run-up jets rise far above the walls; a tank width on either side.
     let edge = (LAYERS as f64 + 1.0) * dx;

@@ -31,11 +31,12 @@
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
 use super::common::{free_surface_params, scheme_params, wall_params};
-use super::fsi_common::{fsi_setup, reference_curve, structure_params, FsiSetup, StructureRun, Watch};
+use super::fsi_common::{
+    check_lattice, fsi_setup, lattice_words, reference_curve, structure_params, FsiSetup, StructureRun, Watch,
+};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::Probe;
-use super::solid_common::{check_count, SolidDefaults};
+use super::solid_common::{Probe, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
@@ -65,6 +66,9 @@ pub const ENTRY: SceneEntry = SceneEntry {
     columns: &["t", "tip_x", "tip_y", "max_speed"],
     outputs: 0,
 };
+
+/// The two lengths the structure's lattice spans, for its particle count and its errors.
+const LATTICE: (&str, &str) = ("gate_thickness", "tank_height");
 
 fn params() -> Vec<Spec> {
     let mut v = vec![
@@ -139,11 +143,7 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
             );
         }
     }
-    check_count(
-        scene,
-        &format!("`dx` = {dx} (`gate_thickness` = {t}, `tank_height` = {th})"),
-        (t / dx) * (th / dx),
-    )?;
+    check_lattice(scene, p, LATTICE)?;
     // The free end swings at most at the water's outflow speed, sqrt(2 g H).
     let u = (2.0 * G * hc).sqrt();
     fsi_setup(scene, p, (&column(p), KEYS), (u, "`column_height`"), G)
@@ -161,8 +161,7 @@ fn gate(p: &Params) -> Result<StructureRun, String> {
     let (fluid, wall) = column(p).bodies(p, s.h, s.constants.c0, s.fluid, G)?;
     let free = lattice(l, l + t, 0.0, gl, dx);
     let fixed = lattice(l, l + t, gl, th, dx);
-    let what = format!("`dx` = {dx} (`gate_thickness` = {t}, `tank_height` = {th})");
-    let gate = s.structure(("elastic_gate", &what), GATE, free, fixed, p)?;
+    let gate = s.structure(("elastic_gate", &lattice_words(p, LATTICE)), GATE, free, fixed, p)?;
     let tip = Probe::new(&gate, "the gate's free end", |x| x[1] < dx)?;
     // Open above: the water running back up the left wall splashes over it; a tank width
     // on either side and eight water heights above (as the dam break's box).

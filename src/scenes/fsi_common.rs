@@ -46,6 +46,19 @@ pub fn structure_params(d: &SolidDefaults) -> Vec<Spec> {
 /// plate in water takes about eighty.
 pub const MAX_SUBSTEPS: u32 = 10_000;
 
+/// What a structure's lattice is made from, for its errors: `dx` and the two lengths it
+/// spans, the parameters `keys`.
+pub fn lattice_words(p: &Params, (a, b): (&str, &str)) -> String {
+    format!("`dx` = {} (`{a}` = {}, `{b}` = {})", p.float("dx"), p.float(a), p.float(b))
+}
+
+/// The structure's particle count, `keys` (see [`lattice_words`]) over `dx` squared,
+/// refused beyond what [`check_count`] allows.
+pub fn check_lattice(scene: &str, p: &Params, keys: (&str, &str)) -> Result<(), String> {
+    let dx = p.float("dx");
+    check_count(scene, &lattice_words(p, keys), (p.float(keys.0) / dx) * (p.float(keys.1) / dx))
+}
+
 /// The sub-steps `p` asks for.
 pub fn substeps(p: &Params) -> Substeps {
     match p.auto_or_int("solid_substeps") {

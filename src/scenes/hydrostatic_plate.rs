@@ -41,11 +41,12 @@ use super::common::{
     forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
     wall_params,
 };
-use super::fsi_common::{fluid_inside, fluid_outside, fsi_setup, structure_params, FsiSetup};
+use super::fsi_common::{
+    check_lattice, fluid_inside, fluid_outside, fsi_setup, lattice_words, structure_params, FsiSetup,
+};
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
-use super::solid_common::Probe;
-use super::solid_common::{check_count, SolidDefaults};
+use super::solid_common::{Probe, SolidDefaults};
 use super::tank::{Column, LAYERS, RHO0};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
@@ -73,6 +74,9 @@ pub const ENTRY: SceneEntry = SceneEntry {
     // Ma = 0.1 (`AT_REST_MACH`).
     outputs: 2,
 };
+
+/// The two lengths the structure's lattice spans, for its particle count and its errors.
+const LATTICE: (&str, &str) = ("width", "plate_thickness");
 
 fn params() -> Vec<Spec> {
     let mut v = vec![
@@ -127,12 +131,7 @@ fn setup(p: &Params) -> Result<FsiSetup, String> {
             p.float("water_height")
         ));
     }
-    let w = p.float("width");
-    check_count(
-        "hydrostatic_plate",
-        &format!("`dx` = {dx} (`width` = {w}, `plate_thickness` = {t})"),
-        (w / dx) * (t / dx),
-    )?;
+    check_lattice("hydrostatic_plate", p, LATTICE)?;
     let g = p.float("gravity");
     // The plate barely moves: its speed stays below the water's sqrt(2 g H).
     let u = (2.0 * 9.81 * p.float("water_height")).sqrt();
@@ -189,8 +188,7 @@ fn plate(p: &Params) -> Result<HydrostaticPlate, String> {
     let free = lattice(0.0, wm, -t, 0.0, dx);
     let mut fixed = lattice(-clamp, 0.0, -t, 0.0, dx);
     fixed.extend(lattice(wm, wm + clamp, -t, 0.0, dx));
-    let what = format!("`dx` = {dx} (`width` = {w}, `plate_thickness` = {t})");
-    let plate = s.structure(("hydrostatic_plate", &what), PLATE, free, fixed, p)?;
+    let plate = s.structure(("hydrostatic_plate", &lattice_words(p, LATTICE)), PLATE, free, fixed, p)?;
     let middle = Probe::new(&plate, "mid-span", |x| (x[0] - 0.5 * wm).abs() < dx)?;
     let edge = (LAYERS as f64 + 1.0) * dx;
     let domain = Domain::bounded([-edge, -t - edge], [w + edge, p.float("tank_height") + edge]);
