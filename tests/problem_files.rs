@@ -201,3 +201,39 @@ fn dam_break_presets_figures_and_stability_sweep() {
     let shapes: Vec<_> = fs.cases.iter().map(|c| c.params.str("shape").to_string()).collect();
     assert_eq!(shapes, ["ring", "patch", "column"]);
 }
+
+/// The committed results hold what the figures read: for every problem, at both presets,
+/// every committed case (a whole finished run in `results/`) holds what each figure and
+/// table drawing from it reads (its files; the snapshots a particle figure draws). A case
+/// lacking any of it is not done for the cache, so a fresh clone's `reproduce` would run it
+/// again: this test says which, in seconds, without a simulation.
+#[test]
+fn every_committed_case_holds_what_its_figures_read() {
+    use sphrepro::automation::cache;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let empty = tempfile::tempdir().unwrap(); // an output folder with nothing: a fresh clone
+    let mut paths: Vec<_> = std::fs::read_dir(root.join("problems"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let (mut bad, mut committed) = (Vec::new(), 0);
+    for path in &paths {
+        let src = std::fs::read_to_string(path).unwrap();
+        for preset in ["quick", "paper"] {
+            let p = registry::parse(path, &src, preset).unwrap();
+            for e in cache::entries(empty.path(), &p) {
+                if e.is_committed() {
+                    committed += 1;
+                }
+                if let cache::State::Incomplete(why) = e.state() {
+                    bad.push(format!("{}/{} ({preset}): {why}", p.name, e.case.name));
+                }
+            }
+        }
+    }
+    assert!(committed > 100, "only {committed} committed case(s) found");
+    bad.dedup();
+    assert!(bad.is_empty(), "{} committed case(s) lack what figures read:\n{}", bad.len(), bad.join("\n"));
+}

@@ -159,6 +159,9 @@ pub enum State {
     /// No folder. If a folder of the same case name with other inputs exists (not the
     /// current result of another preset), the change: the case is stale.
     Missing(Option<String>),
+    /// No result in the output folder, and the committed one lacks what a figure reads
+    /// (see [`reads`](super::reads)), in words: the case runs again.
+    Incomplete(String),
 }
 
 /// A case with its place in the cache.
@@ -173,6 +176,10 @@ pub struct Entry {
     /// Its folder in the committed results, if the problem has such a layer (it may not
     /// exist).
     pub committed: Option<PathBuf>,
+    /// What the committed folder, where it holds a whole finished run, lacks of what the
+    /// problem's figures read from it (see [`reads`](super::reads)), in words: a committed
+    /// result that lacks anything is not one the cache takes as done.
+    committed_lacks: Vec<String>,
     /// The folders of the current cases of the problem's other presets (filled by
     /// [`entries`]): their results are not earlier inputs of this case.
     others: Arc<HashSet<PathBuf>>,
@@ -190,17 +197,34 @@ pub fn recompute_command(problem: &str, preset: &str, case: &str) -> String {
 impl Entry {
     /// The cache entry of `case` of `problem` under `output`.
     pub fn new(output: &Path, problem: &Problem, case: &Case) -> Self {
-        let record = CaseRecord::new(&problem.name, case);
-        let dir = output.join(&problem.name).join(record.folder());
-        let committed = super::results::root(problem).map(|r| r.join(&problem.name).join(record.folder()));
+        let (record, dir, committed) = Self::locate(output, problem, case);
+        let committed_lacks = match &committed {
+            Some(c) if Self::whole(c) => {
+                let has_result = |other: &Case| {
+                    let (_, d, c) = Self::locate(output, problem, other);
+                    Self::finished(&d) || c.as_deref().is_some_and(Self::finished)
+                };
+                super::reads::lacking(c, &super::reads::reads(problem, case, &has_result))
+            }
+            _ => Vec::new(),
+        };
         Self {
             case: case.clone(),
             record,
             dir,
             committed,
+            committed_lacks,
             others: Arc::default(),
             preset: problem.preset.clone(),
         }
+    }
+
+    /// The record of `case` of `problem`, its folder under `output` and its committed folder.
+    fn locate(output: &Path, problem: &Problem, case: &Case) -> (CaseRecord, PathBuf, Option<PathBuf>) {
+        let record = CaseRecord::new(&problem.name, case);
+        let dir = output.join(&problem.name).join(record.folder());
+        let committed = super::results::root(problem).map(|r| r.join(&problem.name).join(record.folder()));
+        (record, dir, committed)
     }
 
     /// Whether `dir` holds a finished (`completed` or `diverged`) summary.
@@ -208,17 +232,29 @@ impl Entry {
         Summary::read(dir).is_ok_and(|s| matches!(s.status, Status::Completed | Status::Diverged))
     }
 
+    /// Whether committed folder `dir` holds a whole finished run (not only its summary, see
+    /// [`results::SUMMARY_ONLY`](super::results::SUMMARY_ONLY)).
+    fn whole(dir: &Path) -> bool {
+        Self::finished(dir) && !dir.join(super::results::SUMMARY_ONLY).exists()
+    }
+
     /// Where its results are read from: the output folder when it holds a finished run,
-    /// else the committed folder when that holds a whole one (not only its summary, see
-    /// [`results::SUMMARY_ONLY`](super::results::SUMMARY_ONLY)), else the output folder.
+    /// else the committed folder when that holds a whole one with everything the figures
+    /// read from it, else the output folder.
     pub fn result_dir(&self) -> &Path {
         if Self::finished(&self.dir) {
             return &self.dir;
         }
         match &self.committed {
-            Some(c) if Self::finished(c) && !c.join(super::results::SUMMARY_ONLY).exists() => c,
+            Some(c) if self.committed_lacks.is_empty() && Self::whole(c) => c,
             _ => &self.dir,
         }
+    }
+
+    /// What the committed result lacks of what the figures read, in words (empty where it
+    /// lacks nothing or there is none).
+    pub fn committed_lacks(&self) -> &[String] {
+        &self.committed_lacks
     }
 
     /// Whether its result is the committed one (none in the output folder).
@@ -247,8 +283,12 @@ impl Entry {
             )),
             // A folder where no simulation started (its runner died writing `case.json`):
             // no log and nothing to resume.
-            Err(_) if self.dir.exists() && !self.started() => State::Missing(self.previous_change()),
-            Err(_) if self.dir.exists() => State::Failed("no summary: the run was killed or crashed".into()),
+            Err(_) if self.dir.exists() && self.started() => {
+                State::Failed("no summary: the run was killed or crashed".into())
+            }
+            Err(_) if !self.committed_lacks.is_empty() => {
+                State::Incomplete(format!("the committed result lacks {}", self.committed_lacks.join("; ")))
+            }
             Err(_) => State::Missing(self.previous_change()),
         }
     }

@@ -100,6 +100,7 @@ pub fn state_word(s: &State) -> String {
         State::Damaged(r) => r.clone(),
         State::Missing(Some(c)) => format!("stale: {c}"),
         State::Missing(None) => "missing".into(),
+        State::Incomplete(r) => format!("incomplete: {r}"),
     }
 }
 
@@ -112,7 +113,7 @@ pub struct StatusCounts {
     pub failed: usize,
     /// With a summary that cannot be read.
     pub damaged: usize,
-    /// Never run, or run with other inputs.
+    /// Never run, or run with other inputs, or committed without what a figure reads.
     pub missing: usize,
     /// Folders that belong to no current case.
     pub stale_folders: usize,
@@ -163,7 +164,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                 State::Done(_) => n.done += 1,
                 State::Failed(_) => n.failed += 1,
                 State::Damaged(_) => n.damaged += 1,
-                State::Missing(_) => n.missing += 1,
+                State::Missing(_) | State::Incomplete(_) => n.missing += 1,
             }
             let running = super::lock::Lock::holder(&e.dir).is_some();
             outln!(
@@ -175,6 +176,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                     State::Damaged(_) => "damaged",
                     State::Missing(Some(_)) => "stale",
                     State::Missing(None) => "missing",
+                    State::Incomplete(_) => "incomplete",
                 },
                 e.case.name,
                 match &st {
@@ -188,6 +190,7 @@ pub fn status(output: &Path, problems: &[Problem], list_stale: bool) -> StatusCo
                     State::Damaged(r) => format!("  ({r})"),
                     State::Missing(Some(c)) => format!("  (inputs changed: {c})"),
                     State::Missing(None) => String::new(),
+                    State::Incomplete(r) => format!("  ({r})"),
                 }
             );
         }

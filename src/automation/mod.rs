@@ -5,6 +5,8 @@
 //! - [`cache`] and [`lock`]: one folder per case keyed by a sha2 digest, one runner per case;
 //!   [`results`]: the committed results, a read-only second layer of the cache, and their
 //!   export;
+//! - [`reads`]: what the figures and tables read from a case's folder, which a committed
+//!   result must hold to be done;
 //! - [`runner`]: a job pool of `simulate` subprocesses;
 //! - [`slurm`]: the same cases as job arrays on a Slurm cluster;
 //! - [`check`]: bounds for CI and case states;
@@ -21,6 +23,7 @@ pub mod check;
 pub mod commands;
 pub mod lock;
 pub mod papers;
+pub mod reads;
 pub mod registry;
 pub mod report;
 pub mod results;

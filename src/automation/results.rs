@@ -6,8 +6,9 @@
 //! (so that it is the same on every clone).
 //!
 //! [`export`] copies the finished cases of the paper preset from the output folder into it:
-//! `case.json`, `summary.json`, `timeseries.csv`, the files the problem's profile figures read
-//! (e.g. `centerline_u.csv`), and only the snapshots its particle figures draw, gzip-compressed
+//! `case.json`, `summary.json`, `timeseries.csv`, and what the figures of any preset of the
+//! problem read from the case ([`reads`](super::reads): the files its profile figures read,
+//! e.g. `centerline_u.csv`, and only the snapshots its particle figures draw), gzip-compressed
 //! (`vtu/fluid_00012.vtu.gz`, with a `fluid.pvd` / `wall.pvd` listing them under the names they
 //! have once uncompressed). Where a claim's paper-preset results are missing, the summaries of
 //! its cases at the other presets go too (for the verdict drawn there), and so do those of
@@ -17,8 +18,9 @@
 //! that draw them say so.
 
 use super::cache::{self, Entry};
-use super::registry::{FigureKind, Problem};
-use super::study::snapshot::{beside, drawn_series, pick_snapshot, pvd_entries, pvd_text};
+use super::reads::{self, Need};
+use super::registry::{Case, FigureKind, Problem};
+use super::study::snapshot::{pvd_entries, pvd_text};
 use crate::solver::output::summary::{Status, Summary};
 use std::collections::{BTreeMap, BTreeSet};
 use std::io::Write as _;
@@ -114,42 +116,34 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
         roots.insert(root.clone());
         let dest = |e: &Entry| root.join(&p.name).join(e.record.folder());
         let entries = cache::entries(output, p);
-        // Every finished case, with the files its figures read.
+        // Every finished case, with what the figures of every preset read from it
+        // (`reads`): its files, and the snapshots the particle figures draw (of the first
+        // case each selects with a result, the one nearest the figure's time, and the
+        // walls' and the structures' nearest it). Per case folder: where it is exported,
+        // and the files of each series drawn.
+        let has_result = |c: &Case| {
+            let e = Entry::new(output, p, c);
+            finished(&dest(&e)) || finished(&e.dir)
+        };
+        let mut snaps: BTreeMap<PathBuf, (PathBuf, BTreeMap<String, BTreeSet<String>>)> = BTreeMap::new();
         for e in entries.iter().filter(|e| finished(&e.dir)) {
-            let mut names = vec!["case.json", "summary.json", "timeseries.csv"];
-            for f in p.figures.iter().filter(|f| f.select.matches(&e.case)) {
-                if let FigureKind::Profile { file, .. } = &f.kind {
-                    if !names.contains(&file.as_str()) {
-                        names.push(file);
+            let mut names = vec!["case.json".to_string(), "summary.json".into(), "timeseries.csv".into()];
+            for r in reads::reads(p, &e.case, &has_result) {
+                match r.need {
+                    Need::File(f) if !names.contains(&f) => names.push(f),
+                    Need::File(_) => {}
+                    Need::Snapshot { time } => {
+                        let slot = snaps.entry(e.dir.clone()).or_insert_with(|| (dest(e), BTreeMap::new()));
+                        for (series, file) in reads::snapshot_files(&e.dir, time)? {
+                            slot.1.entry(series).or_default().insert(file);
+                        }
                     }
                 }
             }
+            let names: Vec<&str> = names.iter().map(String::as_str).collect();
             copy(&e.dir, &dest(e), &names)?;
             let _ = std::fs::remove_file(dest(e).join(SUMMARY_ONLY));
             out.cases += 1;
-        }
-        // The snapshots the particle figures draw: of the first selected case with a result,
-        // the one nearest the figure's time, and the walls' and the structures' nearest it.
-        // Per case folder: where it is exported, and the files of each series drawn.
-        let mut snaps: BTreeMap<PathBuf, (PathBuf, BTreeMap<String, BTreeSet<String>>)> = BTreeMap::new();
-        for f in &p.figures {
-            let FigureKind::Particles { time, .. } = &f.kind else { continue };
-            let drawn = f
-                .select
-                .pick(&p.cases)
-                .into_iter()
-                .map(|c| Entry::new(output, p, c))
-                .find(|e| finished(&dest(e)) || finished(&e.dir));
-            let Some(e) = drawn.filter(|e| finished(&e.dir)) else { continue };
-            let series = drawn_series(&e.dir)?;
-            let list = pvd_entries(&e.dir, &series)?;
-            let (t, file) = pick_snapshot(&list, *time).clone();
-            let slot = snaps.entry(e.dir.clone()).or_insert_with(|| (dest(&e), BTreeMap::new()));
-            slot.1.entry(series.clone()).or_default().insert(file);
-            for other in beside(&e.dir, &series)? {
-                let entries = pvd_entries(&e.dir, &other)?;
-                slot.1.entry(other).or_default().insert(pick_snapshot(&entries, Some(t)).1.clone());
-            }
         }
         for (from, (to, drawn)) in snaps {
             for (series, files) in &drawn {

@@ -104,6 +104,7 @@ pub fn plan(output: &Path, problems: &[Problem], opts: &Options) -> Result<Plan,
                 },
                 State::Missing(Some(change)) => format!("stale: {change}"),
                 State::Missing(None) => "missing".to_string(),
+                State::Incomplete(why) => why,
             };
             plan.tasks.push(Task { problem: p.name.clone(), entry: e, reason });
         }
@@ -360,18 +361,18 @@ fn run_one(
             serde_json::to_value(s).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default(),
         ),
         // `simulate` exits 2 on bad input, having written its one-line error and nothing else.
-        State::Failed(_) | State::Missing(_) if code.code() == Some(2) => {
+        State::Failed(_) | State::Missing(_) | State::Incomplete(_) if code.code() == Some(2) => {
             Outcome::Failed(format!("bad input: {}", last.strip_prefix("error: ").unwrap_or(&last)))
         }
         // It said why it failed, but could not write a summary (a full disk, say).
-        State::Failed(_) | State::Missing(_) | State::Damaged(_)
+        State::Failed(_) | State::Missing(_) | State::Damaged(_) | State::Incomplete(_)
             if code.code() == Some(1) && last.starts_with("failed: ") =>
         {
             Outcome::Failed(format!("{} ({code})", &last["failed: ".len()..]))
         }
         State::Failed(r) => Outcome::Failed(format!("{r} ({code})")),
         State::Damaged(r) => Outcome::Failed(format!("{r} ({code})")),
-        State::Missing(_) => Outcome::Failed(format!("no result ({code})")),
+        State::Missing(_) | State::Incomplete(_) => Outcome::Failed(format!("no result ({code})")),
     };
     // The log ends with how this attempt ended (a resumed case's with its completion).
     let end = match &outcome {
