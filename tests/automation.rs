@@ -782,6 +782,85 @@ fn the_paper_presets_results_are_committed_and_redrawn_byte_for_byte() {
     assert!(text(&o).contains("1 case(s) to run"), "{}", text(&o));
 }
 
+/// A case both presets run, which a particle figure of the quick preset draws and none of
+/// the paper preset's: the export keeps its snapshot for the quick figure, so a fresh
+/// clone's `reproduce` runs nothing committed; a committed case without what a figure reads
+/// (an export from before this rule) is not done, and the cache says what it lacks.
+const SHARED_CASE: &str = r#"title = "tiny"
+scene = "taylor_green"
+paper = "ctvf"
+section = "4.1 Taylor-Green vortex"
+description = "A tiny vortex."
+[params]
+tf = 0.02
+[presets.quick]
+nx = [12]
+drawn = 12
+[presets.paper]
+nx = [12, 14]
+drawn = 14
+[[cases]]
+name = "nx{nx}"
+grid = { nx = "$nx" }
+[[figures]]
+id = "fig12_pressure"
+number = "Fig. 12"
+paper_caption = "The pressure."
+kind = "particles"
+title = "pressure"
+field = "pressure"
+time = 0.02
+where = { nx = "$drawn" }
+caption = "Our pressure."
+"#;
+
+#[test]
+fn a_committed_case_holds_what_the_other_presets_figures_read() {
+    let env = Env::new(SHARED_CASE);
+    let root = &env.root;
+    let o = bare(root, &["reproduce", "--preset", "paper"]);
+    assert!(o.status.success(), "{}", text(&o));
+    let dir = |nx: i64| {
+        std::fs::read_dir(root.join("results/tiny"))
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .find(|d| d.file_name().unwrap().to_string_lossy().starts_with(&format!("nx{nx}-")))
+            .unwrap()
+    };
+    // Each case keeps the one snapshot a figure draws: nx14 the paper's, nx12 the quick one's.
+    for nx in [12, 14] {
+        let snaps = std::fs::read_dir(dir(nx).join("vtu")).unwrap().count();
+        assert_eq!(snaps, 1, "nx{nx}");
+    }
+    // A fresh clone: the quick preset runs nothing, and draws its figure.
+    let clone = tempfile::tempdir().unwrap();
+    for d in ["problems", "results"] {
+        for (rel, bytes) in files(&root.join(d)) {
+            let p = clone.path().join(d).join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, bytes).unwrap();
+        }
+    }
+    let o = bare(clone.path(), &["reproduce"]);
+    let t = text(&o);
+    assert!(o.status.success() && t.contains("0 case(s) to run, 1 done"), "{t}");
+    assert!(clone.path().join("output/manuscript/figures/fig12_pressure.png").exists(), "{t}");
+    // Without the snapshot (an older export), the committed case is not done: it runs.
+    let nx12 = clone.path().join("results/tiny").join(dir(12).file_name().unwrap());
+    std::fs::remove_file(nx12.join("fluid.pvd")).unwrap();
+    std::fs::remove_dir_all(clone.path().join("output")).unwrap();
+    let t = text(&bare(clone.path(), &["status"]));
+    assert!(t.contains("incomplete") && t.contains("0 done, 0 failed, 1 missing"), "{t}");
+    let t = text(&bare(clone.path(), &["run", "tiny", "--dry-run"]));
+    assert!(
+        t.contains("the committed result lacks its snapshot series (*.pvd), which fig12_pressure of the `quick` preset draws"),
+        "{t}"
+    );
+    let o = bare(clone.path(), &["reproduce"]);
+    assert!(o.status.success() && text(&o).contains("1 case(s) to run"), "{}", text(&o));
+}
+
 /// A manuscript from a small synthetic results folder (no simulation): a claim met is
 /// `reproduced`, a claim missed `not reproduced` with the number, and a claim whose
 /// resolution has no result `not run`, naming the missing case with an estimate of its cost.
