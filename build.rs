@@ -9,7 +9,9 @@ fn run(cmd: &str, args: &[&str]) -> Option<String> {
 
 fn main() {
     let commit = run("git", &["rev-parse", "HEAD"]).unwrap_or_else(|| "unknown".into());
-    let dirty = run("git", &["status", "--porcelain", "--untracked-files=no"])
+    // Without optional locks, `git status` does not write the index it refreshes, which
+    // would change `.git/index` and rebuild the binary at the next cargo command.
+    let dirty = run("git", &["--no-optional-locks", "status", "--porcelain", "--untracked-files=no"])
         .map(|s| !s.is_empty())
         .unwrap_or(false);
     let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());

@@ -18,7 +18,8 @@
 //! - `body` (default): a body acceleration `g = q / (rho0 H)` downward on every free
 //!   particle (the solid's gravity), so that the span of length L carries q L;
 //! - `top`: an acceleration `q / (rho0 dx)` downward on the free particles of the top row
-//!   only (the scheme's [`ParticleLoad`]), the same q L on the span, applied at the surface.
+//!   only (a [`UniformLoad`] coupling of the beam with itself), the same q L on the span,
+//!   applied at the surface.
 //!
 //! Both give the same static deflection of a slender beam (Euler-Bernoulli theory knows only
 //! the load per length); the problem file runs both. A load applied suddenly to a beam at
@@ -51,15 +52,15 @@
 //! `timeseries.csv`: `t, midspan_y, midspan_y_exact` (the last: eq. 4.16, constant, for the
 //! figure's reference line).
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
+use super::common::{plan, restore_sim, simulation_with, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{
     check_count, forward_stepwise, solid_params, solid_setup, Extrema, Probe, SolidDefaults, SolidSetup,
 };
 use super::{common_params, SceneEntry, SceneRun};
+use crate::solver::interactions::UniformLoad;
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
-use crate::solver::scheme::ParticleLoad;
 use crate::solver::simulation::Simulation;
 use crate::solver::systems::{ElasticSolid, SolidInit, SolidMaterial};
 use serde::{Deserialize, Serialize};
@@ -283,24 +284,26 @@ fn beam(p: &Params) -> Result<Beam, String> {
     }
     // The load q per unit length on the free span (module docs), as gravity or on the top row.
     let g = q / (material.rho0 * hb);
-    match p.str("load") {
+    let load = match p.str("load") {
         "top" => {
             scheme.gravity = [0.0; 3];
             let top = (ny - 1) * columns;
-            scheme.load = Some(ParticleLoad {
-                accel: [0.0, -q / (material.rho0 * dx), 0.0],
-                first: top,
-                end: top + columns,
-            });
+            Some(UniformLoad::new([0.0, -q / (material.rho0 * dx), 0.0], top..top + columns))
         }
-        _ => scheme.gravity = [0.0, -g, 0.0],
-    }
+        _ => {
+            scheme.gravity = [0.0, -g, 0.0];
+            None
+        }
+    };
     let solid = ElasticSolid::new(BEAM, h, init, material, scheme)?;
     // The middle column (nx odd, at x = L/2) or the two middle columns (nx even, at L/2 ± dx/2).
     let middle = Probe::new(&solid, "mid-span", |x| (x[0] - 0.5 * l).abs() < 0.75 * dx)?;
     let margin = (layers as f64 + 4.0) * dx;
     let domain = Domain::bounded([-margin, -hb - margin], [l + margin, hb + margin]);
-    let sim = simulation("clamped_beam_udl", p, domain, kernel, [solid.into()])?;
+    let sim = simulation_with("clamped_beam_udl", p, domain, kernel, [solid.into()], |b| match load {
+        Some(load) => b.load(BEAM, load),
+        None => b,
+    })?;
     let exact = midspan_deflection_exact(q, l, flexural_rigidity(&material, hb));
     let tf = p.float("tf");
     let mut run = Beam {

@@ -10,7 +10,7 @@ use crate::solver::scheme::{
     paper, Corrections, DensityModel, FluidScheme, FluidSettings, IpstTest, OptionError, PressureReference,
     Pst, SchemeName, SchemeOptions, SurfaceCone, SurfacePressure,
 };
-use crate::solver::simulation::{Simulation, TimeSettings};
+use crate::solver::simulation::{Builder, Simulation, TimeSettings};
 use crate::solver::systems::{
     Body, ElasticSolid, Fluid, FluidInit, Wall, WallDensity, WallPressure, WallViscosity,
 };
@@ -105,10 +105,21 @@ pub fn simulation<const D: usize>(
     kernel: Kernel,
     bodies: impl IntoIterator<Item = Body<D>>,
 ) -> Result<Simulation<D>, String> {
+    simulation_with(scene, p, domain, kernel, bodies, |b| b)
+}
+
+/// As [`simulation`], with what `pairs` sets for pairs of bodies on the builder (a pair kept
+/// apart, two solids summing across, a load on a body).
+pub fn simulation_with<const D: usize>(
+    scene: &str,
+    p: &Params,
+    domain: crate::solver::nnps::Domain<D>,
+    kernel: Kernel,
+    bodies: impl IntoIterator<Item = Body<D>>,
+    pairs: impl FnOnce(Builder<D>) -> Builder<D>,
+) -> Result<Simulation<D>, String> {
     let builder = Simulation::builder(domain, kernel).time(time_settings(p));
-    bodies
-        .into_iter()
-        .fold(builder, |b, body| b.body(body))
+    pairs(bodies.into_iter().fold(builder, |b, body| b.body(body)))
         .build()
         .map_err(|e| format!("scene `{scene}`: {e}"))
 }

@@ -1,4 +1,5 @@
-//! Kick-drift-kick time integration (CTVF eqs. 54-60) and the time-step limits (eq. 61).
+//! Kick-drift-kick time integration (CTVF eqs. 54-60), the time-step limits (eq. 61), the
+//! time loop's settings and what it reports (a blow-up, the time spent per phase).
 
 use crate::solver::math::Vector;
 use rayon::prelude::*;
@@ -22,6 +23,120 @@ pub enum RatePositions {
 }
 
 named_choices!(RatePositions { Start => "start", End => "end" });
+
+/// Why a run stopped early: the physics blew up. A result, not a crash.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Divergence {
+    /// What was found.
+    pub reason: String,
+    /// The step after which it was found.
+    pub step: u64,
+    /// Simulated time at that step.
+    pub time: f64,
+}
+
+/// Settings of the time loop.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct TimeSettings {
+    /// The factor of eq. (61).
+    pub cfl: f64,
+    /// A speed above `blowup_factor` times a fluid's speed of sound counts as a blow-up, so
+    /// that a run that grows without turning NaN still stops ([`BLOWUP_MACH`] in every
+    /// scene).
+    pub blowup_factor: f64,
+    /// Where the density and pressure rates are evaluated.
+    #[serde(default)]
+    pub rate_positions: RatePositions,
+    /// How many steps a structure in a fluid takes per step of the fluid.
+    #[serde(default)]
+    pub solid_substeps: Substeps,
+}
+
+/// How many steps a structure in a fluid takes per step of the fluid (see
+/// [`simulation`](crate::solver::simulation), *Clocks*). A solid no fluid meets steps with
+/// the fluid, at the smallest limit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Substeps {
+    /// As many as the two time-step limits ask: `ceil(fluid's limit / structure's limit)`,
+    /// the fluid at its own limit.
+    #[default]
+    Auto,
+    /// This many (at least one): the fluid's step is its own limit or `n` times the
+    /// structure's, whichever is shorter. With one, both step together at the smaller
+    /// limit: the run without sub-steps.
+    Fixed(u32),
+}
+
+impl TimeSettings {
+    /// The settings of a scene: eq. (61)'s factor; blow-ups at [`BLOWUP_MACH`]; the rates at
+    /// the default [`RatePositions`].
+    pub fn new(cfl: f64) -> Self {
+        Self {
+            cfl,
+            blowup_factor: BLOWUP_MACH,
+            rate_positions: RatePositions::default(),
+            solid_substeps: Substeps::default(),
+        }
+    }
+}
+
+/// The Mach number at which a run counts as blown up. Weakly compressible SPH takes c0 at
+/// least ten times the largest flow speed (Ma <= 0.1), so a particle at the speed of sound
+/// has left the model by ten times its design margin. The quick preset's completed runs peak
+/// at Ma = 0.15 (the Taylor-Green vortex and the cavity, c0 = 10 U) and 0.22 (the dam break);
+/// a bound of 10 c0 let a Taylor-Green run at `cfl = 5` reach 45 U and report `completed`.
+pub const BLOWUP_MACH: f64 = 1.0;
+
+/// Wall-clock seconds spent in each phase of the step, summed over the run (a few clock
+/// reads per step; reported by `sphrepro bench`).
+#[derive(Clone, Copy, Debug, Default, Serialize, Deserialize)]
+pub struct PhaseTimes {
+    /// Kicks, drift and the blow-up check.
+    pub integrate: f64,
+    /// Wrapping, binning, reordering and the neighbour lists with their kernel values (and
+    /// the fluid's share of a summation density, summed as the list is built).
+    pub neighbours: f64,
+    /// Summation density: the boundaries' share.
+    pub density: f64,
+    /// Density and pressure rates and their update (pass A).
+    pub pressure: f64,
+    /// Accelerations and homogenisation (pass B).
+    pub accelerations: f64,
+    /// Iterative shifting.
+    pub ipst: f64,
+}
+
+impl std::ops::AddAssign for PhaseTimes {
+    fn add_assign(&mut self, o: Self) {
+        self.integrate += o.integrate;
+        self.neighbours += o.neighbours;
+        self.density += o.density;
+        self.pressure += o.pressure;
+        self.accelerations += o.accelerations;
+        self.ipst += o.ipst;
+    }
+}
+
+impl PhaseTimes {
+    /// Every phase multiplied by `f` (e.g. 1 / total, for shares).
+    pub fn scaled(&self, f: f64) -> Self {
+        Self {
+            integrate: self.integrate * f,
+            neighbours: self.neighbours * f,
+            density: self.density * f,
+            pressure: self.pressure * f,
+            accelerations: self.accelerations * f,
+            ipst: self.ipst * f,
+        }
+    }
+}
+
+/// Adds the time since `start` to `acc` and returns now.
+pub(crate) fn lap(start: std::time::Instant, acc: &mut f64) -> std::time::Instant {
+    let now = std::time::Instant::now();
+    *acc += (now - start).as_secs_f64();
+    now
+}
 
 /// The limits of CTVF eq. (61), each multiplied by `cfl` (0.25 in the paper):
 /// acoustic `h / (c + |U|)`, viscous `h^2 / nu`, and body force `sqrt(h / |g|)` (the paper

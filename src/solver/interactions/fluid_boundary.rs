@@ -1,4 +1,4 @@
-//! Fluid-boundary: a fluid reads a boundary's particles (a wall's; later a structure's) as
+//! Fluid-boundary: a fluid reads a boundary's particles (a wall's or a structure's) as
 //! neighbours, with the values the boundary presents (Adami et al. 2012; CTVF sec. 3.6):
 //! the divergence terms see its slip velocities and extrapolated pressure (eqs. 48-49, 52),
 //! the viscous terms its no-slip velocity (eq. 50). The transport-velocity terms
@@ -7,6 +7,7 @@
 
 use super::fluid_fluid::{AccelSums, AccelTerms, RateTerms};
 use super::lists::{build_kernel_list_cross, KernelList};
+use super::Coupling;
 use crate::solver::equations::{Pair, Point};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -61,26 +62,29 @@ pub struct BoundarySource<'a, const D: usize> {
 /// shares are added in).
 #[derive(Clone, Copy)]
 pub struct Boundaries<'a, const D: usize> {
-    couplings: &'a [FluidBoundary<D>],
+    couplings: &'a [Coupling<D>],
+    idx: &'a [usize],
     bodies: &'a [Body<D>],
 }
 
 impl<'a, const D: usize> Boundaries<'a, D> {
-    /// The boundaries of `couplings` among `bodies`.
-    pub fn new(couplings: &'a [FluidBoundary<D>], bodies: &'a [Body<D>]) -> Self {
-        Self { couplings, bodies }
+    /// The boundaries of the couplings of indices `idx` among `couplings` (each a
+    /// [`FluidBoundary`]), among `bodies`.
+    pub fn new(couplings: &'a [Coupling<D>], idx: &'a [usize], bodies: &'a [Body<D>]) -> Self {
+        Self { couplings, idx, bodies }
     }
 
     /// No boundary.
     pub fn none() -> Self {
-        Self { couplings: &[], bodies: &[] }
+        Self { couplings: &[], idx: &[], bodies: &[] }
     }
 
     /// Each boundary, in order.
     #[inline(always)]
     pub fn iter(&self) -> impl Iterator<Item = BoundarySource<'a, D>> + 'a {
-        let bodies = self.bodies;
-        self.couplings.iter().map(move |c| {
+        let (couplings, bodies) = (self.couplings, self.bodies);
+        self.idx.iter().map(move |&k| {
+            let c = couplings[k].as_fluid_boundary().expect("a fluid-boundary coupling");
             let (x, model) = bodies[c.boundary].as_boundary().expect("a coupling's boundary presents values");
             BoundarySource { x, model, list: &c.list }
         })

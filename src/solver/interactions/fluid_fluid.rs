@@ -23,6 +23,8 @@ use crate::solver::systems::Fluid;
 /// own share of each particle's density, summed as the list is built.
 #[derive(Debug, Default)]
 pub struct FluidFluid<const D: usize> {
+    /// The fluid's index among the bodies.
+    pub body: usize,
     /// The list, with the kernel values of each pair.
     pub list: KernelList<D>,
     /// `sum_b m_b W_ab` over the fluid's own particles (with a summation density).
@@ -30,9 +32,9 @@ pub struct FluidFluid<const D: usize> {
 }
 
 impl<const D: usize> FluidFluid<D> {
-    /// No list yet.
-    pub fn new() -> Self {
-        Self::default()
+    /// The coupling of fluid `body` with itself, not listed yet.
+    pub fn new(body: usize) -> Self {
+        Self { body, ..Self::default() }
     }
 
     /// Lists the neighbours of `fluid` (binned by `cells` in its current order), summing

@@ -19,7 +19,7 @@ use crate::solver::equations::Point;
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::nnps::CellList;
-use crate::solver::scheme::plan;
+use crate::solver::scheme::{plan, FluidScheme};
 use crate::solver::systems::{BoundaryModel, ElasticSolid, Fluid};
 use rayon::prelude::*;
 
@@ -32,12 +32,14 @@ pub struct StructureFluid<const D: usize> {
     /// The fluid's index.
     pub fluid: usize,
     list: KernelList<D>,
+    /// The fluid's force per unit mass on each particle, as last evaluated.
+    force: Vec<Vector<D>>,
 }
 
 impl<const D: usize> StructureFluid<D> {
     /// The coupling of structure `structure` with fluid `fluid`, not listed yet.
     pub fn new(structure: usize, fluid: usize) -> Self {
-        Self { structure, fluid, list: KernelList::new() }
+        Self { structure, fluid, list: KernelList::new(), force: Vec::new() }
     }
 
     /// Lists the fluid neighbours (`fluid`, binned by `fluid_cells` in its current order) of
@@ -79,35 +81,40 @@ impl<const D: usize> StructureFluid<D> {
     }
 
     /// The fluid's force on every particle of `solid` per unit mass (the opposite of eq.
-    /// 4.15), into `a_fsi`: `-(1/m_s) sum_f m_f a_f<-s`, with `a_f<-s` the acceleration the
-    /// fluid's `terms` gave fluid particle `f` for this neighbour in pass B, from the same
+    /// 4.15): `-(1/m_s) sum_f m_f a_f<-s`, with `a_f<-s` the acceleration the fluid's terms
+    /// (of `physics`) gave fluid particle `f` for this neighbour in pass B, from the same
     /// views (`points`, the fluid's as pass B gathered them; the structure's presented
-    /// ones). Fixed particles (a clamp) take none: their motion is prescribed.
+    /// ones). Fixed particles (a clamp) take none: their motion is prescribed. Kept until
+    /// the next evaluation.
     pub fn reaction(
-        &self,
+        &mut self,
         solid: &ElasticSolid<D>,
         (points, h): (&[Point<D>], f64),
         fluid_x: &[Vector<D>],
-        terms: &AccelTerms,
-        a_fsi: &mut [Vector<D>],
-    ) {
+        physics: &FluidScheme,
+    ) -> &[Vector<D>] {
         let model = solid.boundary.as_ref().expect("a structure a fluid meets presents a boundary model");
+        let terms = AccelTerms::new(physics);
         let list = &self.list;
-        a_fsi.par_iter_mut().enumerate().with_min_len(crate::solver::LIGHT_LOOP_LEN).for_each(|(i, out)| {
-            if solid.fixed[i] {
-                *out = Vector::zeros();
-                return;
-            }
-            let views = [&model.div[i], &model.visc[i], &model.av[i]];
-            let mut force = Vector::<D>::zeros();
-            list.for_each_from(i, solid.x[i], fluid_x, |j, x_sf, r2, kw| {
-                // The fluid's pair: x_fs = -x_sf, so its kernel gradient is this one negated.
-                let pair = kw.pair(-x_sf, r2, h);
-                let mut sums = AccelSums::zero();
-                terms.pressure_and_viscous::<{ plan::RUNTIME }, D>(&mut sums, &points[j], &pair, views);
-                force -= sums.acc * points[j].m;
-            });
-            *out = force / solid.m[i];
-        });
+        self.force.resize(solid.len(), Vector::zeros());
+        self.force.par_iter_mut().enumerate().with_min_len(crate::solver::LIGHT_LOOP_LEN).for_each(
+            |(i, out)| {
+                if solid.fixed[i] {
+                    *out = Vector::zeros();
+                    return;
+                }
+                let views = [&model.div[i], &model.visc[i], &model.av[i]];
+                let mut force = Vector::<D>::zeros();
+                list.for_each_from(i, solid.x[i], fluid_x, |j, x_sf, r2, kw| {
+                    // The fluid's pair: x_fs = -x_sf, so its kernel gradient is this one negated.
+                    let pair = kw.pair(-x_sf, r2, h);
+                    let mut sums = AccelSums::zero();
+                    terms.pressure_and_viscous::<{ plan::RUNTIME }, D>(&mut sums, &points[j], &pair, views);
+                    force -= sums.acc * points[j].m;
+                });
+                *out = force / solid.m[i];
+            },
+        );
+        &self.force
     }
 }

@@ -32,6 +32,25 @@ impl<const D: usize> CellList<D> {
     /// Panics if a periodic axis is shorter than two search radii (the minimum image
     /// would then be ambiguous): scenes check this and report it as a parameter error.
     pub fn new(domain: Domain<D>, radius: f64) -> Self {
+        let mut list = Self {
+            domain,
+            radius,
+            radius2: radius * radius,
+            ncells: [1; D],
+            cell_size: [radius; D],
+            origin: [0.0; D],
+            cell_start: Vec::new(),
+            sorted: Vec::new(),
+            cell_of: Vec::new(),
+        };
+        list.reshape(domain, radius);
+        list
+    }
+
+    /// Makes it a list for queries of `radius` in `domain` (as [`new`](Self::new) does),
+    /// keeping its buffers: a list re-made every step (a structure's, around it) allocates
+    /// only when it grows. It holds no points until the next [`update`](Self::update).
+    pub fn reshape(&mut self, domain: Domain<D>, radius: f64) {
         assert!(radius > 0.0, "search radius must be positive");
         let mut ncells = [1usize; D];
         let mut cell_size = [radius; D];
@@ -52,17 +71,12 @@ impl<const D: usize> CellList<D> {
             }
         }
         let total: usize = ncells.iter().product();
-        Self {
-            domain,
-            radius,
-            radius2: radius * radius,
-            ncells,
-            cell_size,
-            origin,
-            cell_start: vec![0; total + 1],
-            sorted: Vec::new(),
-            cell_of: Vec::new(),
-        }
+        (self.domain, self.radius, self.radius2) = (domain, radius, radius * radius);
+        (self.ncells, self.cell_size, self.origin) = (ncells, cell_size, origin);
+        self.cell_start.clear();
+        self.cell_start.resize(total + 1, 0);
+        self.sorted.clear();
+        self.cell_of.clear();
     }
 
     /// The number of cells a list for queries of `radius` in `domain` would have (as a

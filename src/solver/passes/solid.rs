@@ -1,7 +1,10 @@
 //! The passes of an elastic solid: its density and deviatoric-stress rates (eqs. 25, 31,
 //! 32) and their update (eqs. 56, 8, 58), and its accelerations (eq. 30) with Sun's
 //! shifting (eq. 36) kept tangential near its free surface (sec. 3.4, eq. 44). Gathers over
-//! the body's own neighbour list, each particle writing its own row.
+//! the body's own neighbour list and, where it sums its continuum equations over other
+//! solids too ([`Continuum`]), over theirs, each particle writing its own row. The views of
+//! every solid's particles are gathered ([`SolidPasses::gather`]) before any solid's pass
+//! reads them.
 
 use super::free_surface::SurfaceFields;
 use super::ipst::{Ipst, Shifted, Volumes};
@@ -10,6 +13,7 @@ use crate::solver::equations::free_surface::adjust_shift;
 use crate::solver::equations::solid::SolidPoint;
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::lists::KernelList;
+use crate::solver::interactions::solid_continuum::Continuum;
 use crate::solver::interactions::solid_solid::{AccelSums, AccelTerms, RateSums, RateTerms};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -22,15 +26,17 @@ use rayon::prelude::*;
 /// IPST's work space.
 #[derive(Debug, Default)]
 pub struct SolidPasses<const D: usize> {
-    points: Vec<SolidPoint<D>>,
+    /// The views of the particles, as last gathered.
+    pub(crate) points: Vec<SolidPoint<D>>,
     /// The free surface, when the scheme detects one.
     pub surface: Option<SurfaceFields<D>>,
     ipst: Ipst<D>,
 }
 
 impl<const D: usize> SolidPasses<D> {
-    /// Gathers every particle's [`SolidPoint`] from `solid`.
-    fn gather(&mut self, solid: &ElasticSolid<D>) {
+    /// Gathers every particle's [`SolidPoint`] from `solid`: the views the passes of this
+    /// solid and of those summing over it read.
+    pub fn gather(&mut self, solid: &ElasticSolid<D>) {
         let u_hat = solid.u_hat();
         let transport = solid.physics.gradient == GradientVelocity::Transport;
         let artificial_stress = solid.physics.artificial_stress.map(|a| a.eps);
@@ -56,14 +62,15 @@ impl<const D: usize> SolidPasses<D> {
 }
 
 /// The density rates (eq. 25) and deviatoric-stress rates (eq. 32, with the velocity
-/// gradient of eq. 31) of `solid` over its list `nl`, into `rates`.
+/// gradient of eq. 31) of `solid` over its list `nl` and the solids of `continuum`, into
+/// `rates`, from the views gathered in `passes`.
 pub fn density_and_stress_rates<const D: usize>(
-    passes: &mut SolidPasses<D>,
+    passes: &SolidPasses<D>,
     solid: &ElasticSolid<D>,
     nl: &KernelList<D>,
+    continuum: Continuum<'_, D>,
     rates: &mut SolidRates<D>,
 ) {
-    passes.gather(solid);
     let (pts, x, h) = (&passes.points, &solid.x, solid.h);
     let terms = RateTerms { corrections: solid.physics.corrections };
     let g = solid.material.shear_modulus();
@@ -72,43 +79,59 @@ pub fn density_and_stress_rates<const D: usize>(
             let a = &pts[i];
             let mut sums = RateSums::zero();
             nl.for_each(i, x, |j, xij, r2, kw| terms.neighbour(&mut sums, a, &pts[j], &kw.pair(xij, r2, h)));
+            for other in continuum.iter() {
+                other.list.for_each_from(i, x[i], other.x, |j, xij, r2, kw| {
+                    terms.neighbour(&mut sums, a, &other.points[j], &kw.pair(xij, r2, h))
+                });
+            }
             *drho = sums.drho;
             *ds = terms.stress_rate(a, &sums, g);
         },
     );
 }
 
-/// The accelerations of `solid` (eq. 30 with Monaghan's artificial viscosity, eq. 28,
-/// Monaghan's artificial stress if the scheme has it, the body force and the scheme's
-/// external load on its particle range) over its list `nl` into `rates.du`, and Sun's shifting (eq. 36, for a
-/// step `dt`) into `rates.a_c`, after detecting the free surface (sec. 3.4) if the scheme
-/// asks, with the shifting zero on it and tangential next to it (eq. 44). Fixed particles
-/// get zero of both.
-pub fn accelerations<const D: usize>(
+/// The free surface of `solid` (sec. 3.4) over its own list `nl`, into `passes`, if its
+/// scheme detects one: the shifting is zero on it and tangential next to it (eq. 44).
+pub fn detect_surface<const D: usize>(
     passes: &mut SolidPasses<D>,
     solid: &ElasticSolid<D>,
     nl: &KernelList<D>,
-    rates: &mut SolidRates<D>,
-    dt: f64,
 ) {
-    let s = &solid.physics;
-    if s.free_surface {
+    if solid.physics.free_surface {
         let particles = Particles { x: &solid.x, m: &solid.m, rho: &solid.rho, h: solid.h };
         let fs = passes.surface.get_or_insert_with(SurfaceFields::default);
         fs.detect(particles, nl, Boundaries::none(), solid.material.rho0, SurfaceCone::Support);
     }
-    passes.gather(solid);
+}
+
+/// The accelerations of `solid` (eq. 30 with Monaghan's artificial viscosity, eq. 28,
+/// Monaghan's artificial stress if the scheme has it, and the body force) over its list `nl`
+/// and the solids of `continuum`, with the external acceleration `rates.a_ext` the couplings
+/// added (if any), into `rates.du`; and Sun's shifting (eq. 36, for a step `dt`, over its own
+/// particles only) into `rates.a_c`, zero on the free surface [detected](detect_surface) and
+/// tangential next to it (eq. 44). Reads the views gathered in `passes`. Fixed particles get
+/// zero of both.
+pub fn accelerations<const D: usize>(
+    passes: &SolidPasses<D>,
+    solid: &ElasticSolid<D>,
+    nl: &KernelList<D>,
+    continuum: Continuum<'_, D>,
+    rates: &mut SolidRates<D>,
+    dt: f64,
+) {
+    let s = &solid.physics;
     let (pts, x, h) = (&passes.points, &solid.x, solid.h);
     let terms = AccelTerms {
         viscosity: s.artificial_viscosity.map(|alpha| (alpha, solid.material.c0())),
         sun: s.shifting.map(|sh| (sh.w_dx, sh.r, sh.n)),
         artificial_stress: s.artificial_stress.map(|a| (a.w_dx, a.n)),
     };
+    // Across bodies the continuum terms only: the shifting is each body's own.
+    let across = AccelTerms { sun: None, ..terms };
     // -(Ma c0) 2h / dt, eq. (36)
     let sun_prefactor = s.shifting.map_or(0.0, |sh| -sh.ma_c0 * 2.0 * h / dt);
     rates.a_c_dt = s.transports().then_some(dt);
     let gravity = s.gravity_vector::<D>();
-    let load = s.load;
     let surface = passes.surface.as_ref().filter(|_| s.free_surface);
     let fixed = &solid.fixed;
     let rate = |i: usize| -> (Vector<D>, Vector<D>) {
@@ -118,12 +141,16 @@ pub fn accelerations<const D: usize>(
         let a = &pts[i];
         let mut sums = AccelSums { acc: Vector::zeros(), ac: Vector::zeros() };
         nl.for_each(i, x, |j, xij, r2, kw| terms.neighbour(&mut sums, a, &pts[j], &kw.pair(xij, r2, h)));
+        for other in continuum.iter() {
+            other.list.for_each_from(i, x[i], other.x, |j, xij, r2, kw| {
+                across.neighbour(&mut sums, a, &other.points[j], &kw.pair(xij, r2, h))
+            });
+        }
         let mut ac = sums.ac * sun_prefactor;
         if let Some(fs) = surface {
             ac = adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
         }
-        let external = load.map_or(Vector::zeros(), |l| l.on::<D>(i));
-        (sums.acc + gravity + external, ac)
+        (sums.acc + gravity, ac)
     };
     // Without Sun's shifting the homogenisation is IPST's, or none: only du here.
     if s.shifting.is_none() {
@@ -137,6 +164,9 @@ pub fn accelerations<const D: usize>(
             .with_min_len(MIN_LEN)
             .for_each(|(i, (du, ac))| (*du, *ac) = rate(i));
     }
+    // The external acceleration (thesis eq. 4.6's F_FSI / m, a load): zero on fixed particles.
+    let SolidRates { du, a_ext, .. } = rates;
+    du.iter_mut().zip(a_ext.iter()).for_each(|(du, a)| *du += a);
 }
 
 /// IPST's homogenisation of `solid` (eqs. 37-41, for a step `dt`, on step number `step`)
@@ -177,10 +207,11 @@ pub fn homogenise<const D: usize>(
 #[cfg(test)]
 mod tests {
     use crate::solver::equations::solid::j2;
+    use crate::solver::interactions::UniformLoad;
     use crate::solver::kernel::{Kernel, KernelKind};
     use crate::solver::math::Vector;
     use crate::solver::nnps::Domain;
-    use crate::solver::scheme::{ParticleLoad, Pst, SolidSchemeName, SolidSettings};
+    use crate::solver::scheme::{Pst, SolidSchemeName, SolidSettings};
     use crate::solver::simulation::Simulation;
     use crate::solver::systems::{ElasticSolid, SolidInit, SolidMaterial};
 
@@ -250,8 +281,8 @@ mod tests {
         }
     }
 
-    /// The scheme's external load accelerates the particles of its range and no other, by
-    /// exactly its acceleration: ten particles farther apart than the kernel's support (no
+    /// A uniform load (a coupling of the block with itself) accelerates the particles of its
+    /// range and no other, by exactly its acceleration: ten particles farther apart than the kernel's support (no
     /// neighbours, so no stress and no density change), no shifting, no viscosity; the load
     /// on particles 3..7, one of them fixed. After 100 steps the loaded free particles move
     /// at `a t` and the others, and the fixed one, are at rest (to rounding: 1e-12 a t).
@@ -266,12 +297,12 @@ mod tests {
             init.rho.push(material().rho0);
             init.fixed.push(k == 5);
         }
-        let mut body = solid(init, dx, Pst::None, 0.0);
+        let body = solid(init, dx, Pst::None, 0.0);
         let a = [0.0, -2.5, 0.0];
-        body.physics.load = Some(ParticleLoad { accel: a, first: 3, end: 7 });
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
         let domain = Domain::bounded([-1.0, -1.0], [1.0, 1.0]);
-        let mut sim = Simulation::builder(domain, kernel).body(body).build().unwrap();
+        let load = UniformLoad::new(a, 3..7);
+        let mut sim = Simulation::builder(domain, kernel).body(body).load("block", load).build().unwrap();
         for _ in 0..100 {
             sim.step(f64::INFINITY).unwrap();
         }

@@ -322,7 +322,7 @@ impl Wavefront {
     pub fn step<const D: usize>(&mut self, b: StepBodies<'_, D>, dt: f64, dt_accel: f64) -> StageTimes {
         let clock = Instant::now();
         let StepBodies { fluid, cells, kernel, own, passes, rates } = b;
-        let FluidFluid { list, density: fluid_density } = own;
+        let FluidFluid { list, density: fluid_density, .. } = own;
         let n = fluid.len();
         list.begin(cells, n);
         fluid_density.resize(n, 0.0);

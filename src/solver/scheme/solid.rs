@@ -97,35 +97,6 @@ pub struct SolidScheme {
     pub free_surface: bool,
     /// Body force per unit mass.
     pub gravity: [f64; 3],
-    /// An external acceleration on a range of the body's particles besides gravity (a
-    /// load on one face of the body, e.g.); `None`: none.
-    #[serde(default)]
-    pub load: Option<ParticleLoad>,
-}
-
-/// An external acceleration `accel` on the particles of indices `first..end` of a solid, in
-/// the order the scene gave them (solids are never reordered): a surface traction t (N/m^2
-/// in 3D, N/m in 2D per unit depth) on a face is `accel = t dx / (rho0 dx^D)` on the row of
-/// particles along it. Fixed particles in the range get nothing, as they get no gravity.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ParticleLoad {
-    /// Acceleration (m/s^2).
-    pub accel: [f64; 3],
-    /// The first particle loaded.
-    pub first: usize,
-    /// One past the last particle loaded.
-    pub end: usize,
-}
-
-impl ParticleLoad {
-    /// The load's acceleration on particle `i`: `accel` inside the range, zero outside.
-    pub fn on<const D: usize>(&self, i: usize) -> crate::solver::math::Vector<D> {
-        if (self.first..self.end).contains(&i) {
-            crate::solver::math::Vector::<D>::from_fn(|k, _| self.accel[k])
-        } else {
-            crate::solver::math::Vector::<D>::zeros()
-        }
-    }
 }
 
 impl SolidScheme {
@@ -196,7 +167,6 @@ impl SolidSchemeName {
             artificial_stress,
             free_surface: transports,
             gravity: s.gravity,
-            load: None,
         })
     }
 }
@@ -223,13 +193,6 @@ impl fmt::Display for SolidScheme {
         match self.artificial_viscosity {
             Some(a) => writeln!(f, "  momentum: eq. (30), artificial viscosity alpha = {a} (eq. 28)")?,
             None => writeln!(f, "  momentum: eq. (30)")?,
-        }
-        if let Some(l) = self.load {
-            writeln!(
-                f,
-                "  external load: acceleration {:?} m/s^2 on particles {}..{}",
-                l.accel, l.first, l.end
-            )?;
         }
         if let Some(a) = self.artificial_stress {
             writeln!(f, "  artificial stress: Monaghan (Gray et al. 2001), eps = {}, n = {}", a.eps, a.n)?;

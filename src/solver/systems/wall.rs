@@ -131,6 +131,18 @@ impl<const D: usize> Wall<D> {
     }
 }
 
+/// The stages of a [`Wall`]: it moves as prescribed, and is binned again when it does.
+pub struct WallStages;
+
+impl<const D: usize> super::BodyStages<D> for WallStages {
+    fn rebin(&self, w: &mut super::World<D>, i: usize) {
+        let wall = w.bodies[i].as_wall().expect("a wall");
+        if wall.moves() {
+            w.bins[i].update(&wall.x);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

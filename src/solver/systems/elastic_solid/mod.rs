@@ -17,6 +17,10 @@
 //! (sec. 4.7): after every stress update the deviatoric stress is returned radially onto
 //! the von Mises surface ([`radial_return`]).
 
+mod stages;
+
+pub use stages::{SolidStages, SolidWork};
+
 use super::boundary::{BoundaryMaterial, BoundaryModel};
 use crate::solver::equations::solid::radial_return;
 use crate::solver::integrator;
@@ -162,11 +166,17 @@ pub struct SolidRates<const D: usize> {
     /// The step eq. (36) divided (du/dt)_c by (see
     /// [`FluidRates::a_c_dt`](super::FluidRates::a_c_dt)).
     pub a_c_dt: Option<f64>,
-    /// The fluid's force on each particle per unit mass, F_FSI / m of eq. (4.6) (the
-    /// opposite of eq. 4.15), included in `du`; empty for a solid no fluid acts on. Held
-    /// over a structure's sub-steps (see [`Simulation`](crate::solver::simulation)).
-    #[serde(default)]
-    pub a_fsi: Vec<Vector<D>>,
+    /// The external acceleration computed at a slower clock than the body's and held over
+    /// its sub-steps: the fluid's force on a structure per unit mass, F_FSI / m of eq. (4.6)
+    /// (the opposite of eq. 4.15); empty for a solid no fluid acts on (see
+    /// [`simulation`](crate::solver::simulation), *Clocks*).
+    #[serde(default, alias = "a_fsi")]
+    pub a_held: Vec<Vector<D>>,
+    /// The external acceleration at the last evaluation, included in `du`: the held one plus
+    /// what the couplings at the body's own clock added (a load); empty for a solid that
+    /// none acts on.
+    #[serde(skip)]
+    pub a_ext: Vec<Vector<D>>,
 }
 
 impl<const D: usize> SolidRates<D> {
@@ -179,7 +189,8 @@ impl<const D: usize> SolidRates<D> {
             ds: vec![Matrix::zeros(); n],
             a_c: if solid.physics.transports() { vec![Vector::zeros(); n] } else { Vec::new() },
             a_c_dt: None,
-            a_fsi: if solid.boundary.is_some() { vec![Vector::zeros(); n] } else { Vec::new() },
+            a_held: if solid.boundary.is_some() { vec![Vector::zeros(); n] } else { Vec::new() },
+            a_ext: Vec::new(),
         }
     }
 }
@@ -241,6 +252,51 @@ impl<const D: usize> ElasticSolid<D> {
     /// Number of particles.
     pub fn len(&self) -> usize {
         self.x.len()
+    }
+
+    /// Keeps the particles `keep` marks, in their order. Errors for a structure a fluid
+    /// reads (its boundary values are sized once).
+    pub fn retain(&mut self, keep: &[bool]) -> Result<(), String> {
+        use super::retain_by;
+        if self.boundary.is_some() {
+            return Err(format!("solid `{}`: a structure a fluid reads keeps its particles", self.name));
+        }
+        retain_by(&mut self.x, keep);
+        retain_by(&mut self.u, keep);
+        if let Some(uh) = self.u_hat.as_mut() {
+            retain_by(uh, keep);
+        }
+        retain_by(&mut self.m, keep);
+        retain_by(&mut self.rho, keep);
+        retain_by(&mut self.p, keep);
+        retain_by(&mut self.s, keep);
+        retain_by(&mut self.fixed, keep);
+        Ok(())
+    }
+
+    /// Appends the particles of `more`, a solid of the same material, scheme and smoothing
+    /// length (as built). Errors as [`retain`](Self::retain), and for another material.
+    pub fn extend(&mut self, more: ElasticSolid<D>) -> Result<(), String> {
+        if self.boundary.is_some() {
+            return Err(format!("solid `{}`: a structure a fluid reads keeps its particles", self.name));
+        }
+        if more.material != self.material || more.h != self.h || more.physics.name != self.physics.name {
+            return Err(format!(
+                "solid `{}` differs from solid `{}` in its material, scheme or smoothing length",
+                more.name, self.name
+            ));
+        }
+        self.x.extend(more.x);
+        self.u.extend(more.u);
+        if let (Some(mine), Some(theirs)) = (self.u_hat.as_mut(), more.u_hat) {
+            mine.extend(theirs);
+        }
+        self.m.extend(more.m);
+        self.rho.extend(more.rho);
+        self.p.extend(more.p);
+        self.s.extend(more.s);
+        self.fixed.extend(more.fixed);
+        Ok(())
     }
 
     /// Whether the body has no particles (never true for a constructed body).

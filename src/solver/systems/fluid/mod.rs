@@ -1,7 +1,11 @@
 //! A fluid body: positions, velocities, mass, density, pressure, and the transport
 //! velocity only when its scheme moves particles with one; its physics (the scheme, with
 //! its material constants), its time-step limit (eq. 61) and its kick-drift-kick updates
-//! (eqs. 54-60).
+//! (eqs. 54-60); what it does at each stage of a step is in [`stages`].
+
+mod stages;
+
+pub use stages::{FluidStages, FluidWork};
 
 use super::permute;
 use crate::solver::integrator;
@@ -245,14 +249,65 @@ impl<const D: usize> Fluid<D> {
         permute(&mut self.id, order, &mut self.scratch_id);
     }
 
-    /// Values indexed by original particle id (for output that must not depend on the
-    /// internal ordering).
+    /// Values in the order of the particles' original ids (for output that must not depend
+    /// on the internal ordering).
     pub fn by_id<T: Copy + Default>(&self, v: &[T]) -> Vec<T> {
-        let mut out = vec![T::default(); v.len()];
-        for (k, &i) in self.id.iter().enumerate() {
-            out[i as usize] = v[k];
+        let n = v.len();
+        if self.id.iter().all(|&i| (i as usize) < n) {
+            // Ids 0..n, as built: each its own slot.
+            let mut out = vec![T::default(); n];
+            for (k, &i) in self.id.iter().enumerate() {
+                out[i as usize] = v[k];
+            }
+            return out;
         }
-        out
+        // Particles removed or added: in increasing id.
+        let mut order: Vec<usize> = (0..n).collect();
+        order.sort_unstable_by_key(|&k| self.id[k]);
+        order.into_iter().map(|k| v[k]).collect()
+    }
+
+    /// Keeps the particles `keep` marks, in their order, with their ids.
+    pub fn retain(&mut self, keep: &[bool]) -> Result<(), String> {
+        use super::retain_by;
+        retain_by(&mut self.x, keep);
+        retain_by(&mut self.u, keep);
+        if let Some(uh) = self.u_hat.as_mut() {
+            retain_by(uh, keep);
+        }
+        retain_by(&mut self.m, keep);
+        retain_by(&mut self.rho, keep);
+        retain_by(&mut self.p, keep);
+        retain_by(&mut self.id, keep);
+        Ok(())
+    }
+
+    /// Appends the particles of `more`, a fluid body of the same physics and smoothing
+    /// length (as built), with ids after this one's largest; its parts keep their names.
+    pub fn extend(&mut self, more: Fluid<D>) -> Result<(), String> {
+        let next = self.id.iter().max().map_or(0, |&i| i + 1);
+        let (a, b) = (&self.parts[0].name, &more.parts[0].name);
+        if !more.physics.same_physics(&self.physics) || more.h != self.h {
+            return Err(format!("fluid `{b}` differs from fluid `{a}` in its physics or smoothing length"));
+        }
+        if next as usize + more.len() > u32::MAX as usize {
+            return Err(format!("fluids `{a}` and `{b}`: more particles than a body indexes"));
+        }
+        self.parts.extend(
+            more.parts
+                .into_iter()
+                .map(|p| FluidPart { name: p.name, ids: p.ids.start + next..p.ids.end + next }),
+        );
+        self.x.extend(more.x);
+        self.u.extend(more.u);
+        if let (Some(mine), Some(theirs)) = (self.u_hat.as_mut(), more.u_hat) {
+            mine.extend(theirs);
+        }
+        self.m.extend(more.m);
+        self.rho.extend(more.rho);
+        self.p.extend(more.p);
+        self.id.extend(more.id.into_iter().map(|i| i + next));
+        Ok(())
     }
 }
 
