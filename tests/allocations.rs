@@ -1,5 +1,6 @@
-//! Once warmed up, a time step allocates nothing: every pass and the neighbour search reuse
-//! their buffers (STYLE 6.11). Counted with a global allocator over whole steps, on a pool of
+//! Once warmed up, a time step allocates nothing, in a fluid, a solid or a fluid-structure
+//! scene: every pass, the neighbour search and the sub-steps' binning reuse their buffers
+//! (STYLE 6.11). Counted with a global allocator over whole steps, on a pool of
 //! two threads as the binary runs them. One test function, because the count is global to
 //! the test binary.
 
@@ -68,6 +69,15 @@ fn steps_allocate_nothing_once_warm() {
         (scenes::find("cavity").unwrap(), &["nx=20"]),
         (scenes::find("hydrostatic_tank").unwrap(), &["dx=0.1"]),
         (scenes::find("dam_break").unwrap(), &["dx=0.1", "pst=ipst"]),
+        // Solids, one body and two summing across, under a load coupling.
+        (scenes::find("oscillating_plate").unwrap(), &["dx=0.005"]),
+        (scenes::find("colliding_rings").unwrap(), &["dx=0.002", "pst=ipst"]),
+        (scenes::find("colliding_rings").unwrap(), &["dx=0.002", "rings=two_bodies"]),
+        (scenes::find("clamped_beam_udl").unwrap(), &["dx=0.002", "load=top"]),
+        (scenes::find("uniaxial_compression").unwrap(), &["dx=0.002"]),
+        // Structures in water: sub-steps in a box around the plate, and one sub-step.
+        (scenes::find("hydrostatic_plate").unwrap(), &["dx=0.025"]),
+        (scenes::find("dam_break_elastic_plate").unwrap(), &["dx=0.004"]),
     ];
     // One pool, every thread of it started (a thread allocates as it starts, which under load
     // can fall in a counted window; that is rayon's, not the step's).

@@ -5,9 +5,11 @@
 //! a stale folder can say which input changed.
 //!
 //! A second, read-only layer holds the committed results (`results/`, next to the problems
-//! folder; see [`results`](super::results)): a case whose folder there holds a finished
-//! summary is done too, so that a fresh clone runs nothing that was committed. A result in
-//! the output folder comes first (a forced rerun replaces the committed one).
+//! folder, [`root`]; the paper preset's export writes it): a case whose folder there holds a
+//! finished summary and everything the figures of every preset read from it
+//! ([`reads`](super::reads)) is done too, so that a fresh clone runs nothing that was
+//! committed. A result in the output folder comes first (a forced rerun replaces the
+//! committed one).
 
 use super::registry::{Case, Problem};
 use crate::solver::output::summary::{Status, Summary, SCHEME_VERSION};
@@ -16,6 +18,23 @@ use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+/// The file that marks a committed case folder holding only its summary (a case of another
+/// preset, exported for a verdict or a stability table): it is read by the paper preset's
+/// manuscript, and is not a done case for the cache (the case's figures need more).
+pub const SUMMARY_ONLY: &str = "SUMMARY_ONLY";
+
+/// The committed results' folder of `problem`: `results/` beside its problems folder (`None`
+/// for a file given without a folder).
+pub fn root(problem: &Problem) -> Option<PathBuf> {
+    root_of(problem.path.parent()?)
+}
+
+/// The committed results' folder beside the problems folder `problems`.
+pub fn root_of(problems: &Path) -> Option<PathBuf> {
+    let parent = problems.parent()?;
+    Some(parent.join("results"))
+}
 
 /// Versions of parts of the solver that only some cases use, each raised whenever that
 /// part's results change for unchanged parameters: `(parameter, value, version)`. A case
@@ -223,7 +242,7 @@ impl Entry {
     fn locate(output: &Path, problem: &Problem, case: &Case) -> (CaseRecord, PathBuf, Option<PathBuf>) {
         let record = CaseRecord::new(&problem.name, case);
         let dir = output.join(&problem.name).join(record.folder());
-        let committed = super::results::root(problem).map(|r| r.join(&problem.name).join(record.folder()));
+        let committed = root(problem).map(|r| r.join(&problem.name).join(record.folder()));
         (record, dir, committed)
     }
 
@@ -233,9 +252,9 @@ impl Entry {
     }
 
     /// Whether committed folder `dir` holds a whole finished run (not only its summary, see
-    /// [`results::SUMMARY_ONLY`](super::results::SUMMARY_ONLY)).
+    /// [`SUMMARY_ONLY`]).
     fn whole(dir: &Path) -> bool {
-        Self::finished(dir) && !dir.join(super::results::SUMMARY_ONLY).exists()
+        Self::finished(dir) && !dir.join(SUMMARY_ONLY).exists()
     }
 
     /// Where its results are read from: the output folder when it holds a finished run,

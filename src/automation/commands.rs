@@ -296,7 +296,7 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
 /// clone; the export above brings the output folder's new results there first); for any
 /// other, the output folder over the committed results.
 fn read_from(dirs: &Dirs, problems: &[Problem]) -> PathBuf {
-    match (problems.first().map(|p| p.preset.as_str()), results::root_of(&dirs.problems)) {
+    match (problems.first().map(|p| p.preset.as_str()), cache::root_of(&dirs.problems)) {
         (Some(results::EXPORT_PRESET), Some(root)) => root,
         _ => dirs.output.clone(),
     }

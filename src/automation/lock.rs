@@ -115,6 +115,46 @@ impl Lock {
         std::os::unix::io::AsRawFd::as_raw_fd(&self.file)
     }
 
+    /// Hands the lock down to the simulation `cmd` starts, and ties its life to this
+    /// process's: the child inherits the open
+    /// lock file, passed as `--lock-fd` (taken up there with [`Lock::adopt`]), so the case
+    /// stays locked while either lives and no other runner starts it; and (Linux) it is sent
+    /// SIGUSR1, which stops it with a checkpoint as Ctrl-C does, when this process dies, even
+    /// by SIGKILL. Not SIGTERM: the kernel sends the signal again each time the child passes
+    /// to another of the dying parent's threads, and a second SIGTERM, like a second Ctrl-C,
+    /// ends a run at once.
+    #[cfg(unix)]
+    pub fn hand_down(&self, cmd: &mut std::process::Command) {
+        use std::os::unix::process::CommandExt;
+        let lock_fd = self.inherit_fd();
+        cmd.arg("--lock-fd").arg(lock_fd.to_string());
+        #[cfg(target_os = "linux")]
+        // SAFETY: getpid is async-signal-safe and called before the fork.
+        let pid = unsafe { libc::getpid() };
+        // SAFETY: between fork and exec only async-signal-safe calls (fcntl, prctl, getppid)
+        // on a descriptor this process owns.
+        unsafe {
+            cmd.pre_exec(move || {
+                let flags = libc::fcntl(lock_fd, libc::F_GETFD);
+                if flags < 0 || libc::fcntl(lock_fd, libc::F_SETFD, flags & !libc::FD_CLOEXEC) < 0 {
+                    return Err(std::io::Error::last_os_error());
+                }
+                #[cfg(target_os = "linux")]
+                {
+                    if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGUSR1) < 0 {
+                        return Err(std::io::Error::last_os_error());
+                    }
+                    // The parent may have died before the prctl: no such process (an error
+                    // that allocates nothing, as nothing may between fork and exec).
+                    if libc::getppid() != pid {
+                        return Err(std::io::Error::from_raw_os_error(libc::ESRCH));
+                    }
+                }
+                Ok(())
+            });
+        }
+    }
+
     /// Takes up the lock of `dir` that the runner which started this process holds and
     /// handed down as the open descriptor `fd`: checked to be that folder's lock file, so
     /// that a wrong number is an error, not a run without a lock.

@@ -17,7 +17,7 @@
 //! under [`BUDGET`] bytes: past it, the largest snapshots are dropped (named), and the figures
 //! that draw them say so.
 
-use super::cache::{self, Entry};
+use super::cache::{self, root, Entry, SUMMARY_ONLY};
 use super::reads::{self, Need};
 use super::registry::{Case, FigureKind, Problem};
 use super::study::snapshot::{pvd_entries, pvd_text};
@@ -32,27 +32,10 @@ pub const EXPORT_PRESET: &str = "paper";
 /// The size the committed results keep under, in bytes.
 pub const BUDGET: u64 = 50_000_000;
 
-/// The file that marks a committed case folder holding only its summary (a case of another
-/// preset, exported for a verdict or a stability table): it is read by the paper preset's
-/// manuscript, and is not a done case for the cache (the case's figures need more).
-pub const SUMMARY_ONLY: &str = "SUMMARY_ONLY";
-
 const SUMMARY_ONLY_TEXT: &str =
     "Only case.json and summary.json of this case are committed: the paper preset's \
 manuscript reads them (a verdict drawn at this case's preset, a stability table). The cache \
 does not take the case as done; `sphrepro run` computes it whole.\n";
-
-/// The committed results' folder of `problem`: `results/` beside its problems folder (`None`
-/// for a file given without a folder).
-pub fn root(problem: &Problem) -> Option<PathBuf> {
-    root_of(problem.path.parent()?)
-}
-
-/// The committed results' folder beside the problems folder `problems`.
-pub fn root_of(problems: &Path) -> Option<PathBuf> {
-    let parent = problems.parent()?;
-    Some(parent.join("results"))
-}
 
 /// What an export did.
 #[derive(Debug, Default)]

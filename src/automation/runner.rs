@@ -283,10 +283,7 @@ fn run_one(
     // cannot write there (a full disk) still reaches the report.
     cmd.stdout(Stdio::from(stdout)).stderr(Stdio::piped());
     #[cfg(unix)]
-    {
-        cmd.arg("--lock-fd").arg(lock.inherit_fd().to_string());
-        bind_to_runner(&mut cmd, lock.inherit_fd());
-    }
+    lock.hand_down(&mut cmd);
     let t0 = Instant::now();
     let mut child = match cmd.spawn() {
         Ok(c) => c,
@@ -388,40 +385,6 @@ fn run_one(
             Outcome::Failed(format!("{why}; its log could not be written: {}: {err}", log_path.display()))
         }
         (outcome, _) => outcome,
-    }
-}
-
-/// Ties the simulation's life to this runner's: it inherits the case's lock, so no other
-/// runner starts the case while it lives, and (Linux) it is sent SIGUSR1, which stops it
-/// with a checkpoint as Ctrl-C does, when the runner dies, even by SIGKILL. Not SIGTERM:
-/// the kernel sends the signal again each time the child passes to another of the dying
-/// runner's threads, and a second SIGTERM, like a second Ctrl-C, ends a run at once.
-#[cfg(unix)]
-fn bind_to_runner(cmd: &mut Command, lock_fd: std::os::unix::io::RawFd) {
-    use std::os::unix::process::CommandExt;
-    #[cfg(target_os = "linux")]
-    // SAFETY: getpid is async-signal-safe and called before the fork.
-    let runner = unsafe { libc::getpid() };
-    // SAFETY: between fork and exec only async-signal-safe calls (fcntl, prctl, getppid)
-    // on a descriptor this process owns.
-    unsafe {
-        cmd.pre_exec(move || {
-            let flags = libc::fcntl(lock_fd, libc::F_GETFD);
-            if flags < 0 || libc::fcntl(lock_fd, libc::F_SETFD, flags & !libc::FD_CLOEXEC) < 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            #[cfg(target_os = "linux")]
-            {
-                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGUSR1) < 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                // The runner may have died before the prctl.
-                if libc::getppid() != runner {
-                    return Err(std::io::Error::other("the runner has exited"));
-                }
-            }
-            Ok(())
-        });
     }
 }
 

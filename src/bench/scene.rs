@@ -10,7 +10,7 @@
 
 use super::case::{default_steps, WARMUP};
 use super::process::{bench_child, print_json};
-use super::stats::median_runs;
+use super::stats::{median_runs, throughput_and_runs, Repeated};
 use super::timing::status_kb;
 use crate::scenes::{self, SceneRun};
 use crate::solver::output::summary::Provenance;
@@ -48,6 +48,15 @@ pub(super) struct SceneResult {
     /// ([`median_runs`]); empty in the JSON's list of every run.
     #[serde(default)]
     pub runs: Vec<f64>,
+}
+
+impl Repeated for SceneResult {
+    /// One scene at one set of parameters per bench: its runs differ in threads alone.
+    type Key = usize;
+    fn key(&self) -> Self::Key {
+        self.threads
+    }
+    throughput_and_runs!();
 }
 
 /// Steps `run` `n` more steps (fewer if it reaches the scene's end time `tf` first);

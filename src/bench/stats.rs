@@ -4,7 +4,6 @@
 
 use super::case::BenchResult;
 use super::peer::PeerResult;
-use super::scene::SceneResult;
 use serde::Serialize;
 
 /// A timed run that may be repeated: what makes two runs the same configuration, its
@@ -37,20 +36,12 @@ macro_rules! throughput_and_runs {
         }
     };
 }
+pub(super) use throughput_and_runs;
 
 impl Repeated for BenchResult {
     type Key = (String, String, usize, usize, usize);
     fn key(&self) -> Self::Key {
         (self.variant.clone(), self.kernel.clone(), self.nx, self.threads, self.copies)
-    }
-    throughput_and_runs!();
-}
-
-impl Repeated for SceneResult {
-    /// One scene at one set of parameters per bench: its runs differ in threads alone.
-    type Key = usize;
-    fn key(&self) -> Self::Key {
-        self.threads
     }
     throughput_and_runs!();
 }

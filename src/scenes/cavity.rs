@@ -14,13 +14,16 @@
 //! interpolations of the fluid particles. Files: `centerline_u.csv` (y, u) and
 //! `centerline_v.csv` (x, v), 101 points each.
 
-use super::common::{
-    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, forward_to_sim, plan, restore_sim,
-    scheme_params, shepard, shifting_columns, simulation, snapshot_bodies, wall_density, wall_from,
-    wall_params, wall_pressure, wall_viscosity, FluidConstants,
-};
+use super::fluid_scheme::{fluid_scheme, scheme_params, FluidConstants};
 use super::geometry::{box_walls, lattice};
+use super::measure::shepard;
+use super::memory::check_size;
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{shifting_columns, snapshot_bodies};
+use super::stepping::{checkpoint, forward_to_sim, plan, simulation};
+use super::walls::{
+    check_wall_layers, fluid_at_rest, wall_density, wall_from, wall_params, wall_pressure, wall_viscosity,
+};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -235,15 +238,7 @@ impl SceneRun for Cavity {
         m.insert("min_density".into(), self.min_density);
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "energy": &self.energy, "min_density": self.min_density })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.energy =
-            serde_json::from_value(state["energy"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        self.min_density = state["min_density"].as_f64().ok_or("checkpoint: no `min_density`")?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(energy, min_density);
 }
 
 #[cfg(test)]

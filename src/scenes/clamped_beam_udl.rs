@@ -52,11 +52,10 @@
 //! `timeseries.csv`: `t, midspan_y, midspan_y_exact` (the last: eq. 4.16, constant, for the
 //! figure's reference line).
 
-use super::common::{plan, restore_sim, simulation_with, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, Extrema, Probe, SolidDefaults, SolidSetup,
-};
+use super::snapshots::snapshot_bodies;
+use super::solid_common::{solid_params, solid_setup, BlockSetup, Extrema, Probe, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation_with};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::interactions::UniformLoad;
 use crate::solver::math::Vector;
@@ -142,15 +141,7 @@ pub fn first_mode_period(m: &SolidMaterial, length: f64, height: f64) -> f64 {
 }
 
 /// What the parameters make, once every check that needs no particle has passed.
-struct Setup {
-    solid: SolidSetup,
-    /// Beam columns and rows, and clamp layers.
-    nx: usize,
-    ny: usize,
-    layers: usize,
-}
-
-fn setup(p: &Params) -> Result<Setup, String> {
+fn setup(p: &Params) -> Result<BlockSetup, String> {
     let scene = "clamped_beam_udl";
     let (l, hb, q) = (p.float("length"), p.float("height"), p.float("q"));
     let m = SolidMaterial::new(p.float("youngs_modulus"), p.float("poisson_ratio"), p.float("density"));
@@ -165,24 +156,23 @@ fn setup(p: &Params) -> Result<Setup, String> {
     let g = q / (p.float("density") * hb);
     let solid = solid_setup(scene, p, (u, "`q`, `length` and `height`"), u.max(1e-6), [0.0, -g, 0.0])?;
     let dx = solid.dx;
-    let (nxf, nyf) = ((l / dx).round(), (hb / dx).round());
+    let nyf = (hb / dx).round();
     if nyf < MIN_ACROSS {
         return Err(format!(
             "scene `{scene}`: parameter `dx` = {dx:?}: gives {nyf} particles through `height` = {hb:?}, fewer than {MIN_ACROSS}"
         ));
     }
-    if nxf < 4.0 * nyf {
+    if (l / dx).round() < 4.0 * nyf {
         return Err(format!(
             "scene `{scene}`: parameter `length` = {l:?}: shorter than 4 `height` = {hb:?} at `dx` = {dx:?}: not a beam"
         ));
     }
-    check_count(
+    solid.block(
         scene,
         &format!("the beam (`length` = {l:?}, `height` = {hb:?}) at `dx` = {dx:?}"),
-        nxf * nyf,
-    )?;
-    let layers = solid.support_layers();
-    Ok(Setup { solid, nx: nxf as usize, ny: nyf as usize, layers })
+        (l, hb),
+        (4.0, MIN_ACROSS),
+    )
 }
 
 /// The mean of a signal over a time window, trimmed to whole periods between its first and
@@ -266,7 +256,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 }
 
 fn beam(p: &Params) -> Result<Beam, String> {
-    let Setup { solid: SolidSetup { material, mut scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
+    let BlockSetup { solid: SolidSetup { material, mut scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
     let (l, hb, q) = (nx as f64 * dx, ny as f64 * dx, p.float("q"));
     let columns = nx + 2 * layers;
     let mut init = SolidInit::<2>::default();
@@ -363,13 +353,7 @@ impl SceneRun for Beam {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "mean": &self.mean })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.mean = serde_json::from_value(state["mean"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(mean);
 }
 
 #[cfg(test)]

@@ -19,10 +19,17 @@
 //! the other ring, then anticlockwise), each of mass rho0 2 pi r_k dx / N_k (the annulus'
 //! area shared out, so the ring's mass is exact). The centres lie on the x axis at
 //! -/+ `separation` / 2; the default separation of 0.082 m (outer surfaces 2 mm apart) is
-//! the authors' PySPH set-up (centres at -/+ 0.041 m). Both rings are ONE
-//! [`ElasticSolid`] body (left ring first, then the right one): when they touch they
-//! interact through the same SPH equations as the particles of one ring, as in Gray et al.
-//! 2001 and PySPH's example; there is no contact law.
+//! the authors' PySPH set-up (centres at -/+ 0.041 m).
+//!
+//! **One body or two** (`rings`). With `one_body` both rings are ONE [`ElasticSolid`] body
+//! (left ring first, then the right one): when they touch they interact through the same SPH
+//! equations as the particles of one ring, as in Gray et al. 2001 and PySPH's example, and
+//! so do the shifting, its free-surface detection and the normals. With `two_bodies` they are
+//! two bodies, `ring_1` (left) and `ring_2`, as the CTVF authors' code sets them up: each
+//! sums its continuum equations over the other's particles as over its own
+//! ([`SolidPair::Continuum`]), while its shifting, IPST and free-surface detection run over
+//! its own particles only. There is no contact law either way. The snapshots hold both rings
+//! in one series (`rings.pvd`, with a `body` array for two bodies).
 //!
 //! **Points A and B** (fig. 27, whose drawing our text of the paper lacks): A is the
 //! particle of the left ring's outermost circle nearest its top (angle pi/2 from its
@@ -31,8 +38,8 @@
 //! symmetric.
 //!
 //! Metrics:
-//! - `clusters_max` and `max_gap`: the numerical-fracture detector ([`fracture`]) over the
-//!   whole body (both rings) at every time-series row and at the end: the largest number of
+//! - `clusters_max` and `max_gap`: the numerical-fracture detector ([`fracture`]) over
+//!   both rings at every time-series row and at the end: the largest number of
 //!   clusters (particles closer than 1.5 dx connected) and the largest nearest-neighbour
 //!   distance, in dx. Two whole rings apart are 2 clusters; rings in contact are 1; more
 //!   than 2 is fracture.
@@ -52,13 +59,13 @@
 //! `timeseries.csv`: `t, ax, ay, bx, by, u_left, energy, clusters, max_gap`: the points A
 //! and B, U of the left ring, E, and the detector.
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
-};
+use super::snapshots::{snapshot_bodies, write_solids};
+use super::solid_common::{check_count, solid_params, solid_setup, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation_with};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::fracture;
+use crate::solver::interactions::{PairParams, SolidPair};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
 use crate::solver::simulation::Simulation;
@@ -70,8 +77,11 @@ use std::path::Path;
 /// Particles closer than this many initial spacings are connected in the fracture detector.
 pub const LINK: f64 = 1.5;
 
-/// The body's name.
+/// The body's name with `rings = one_body`, and the snapshot series' either way.
 const RINGS: &str = "rings";
+
+/// The bodies' names with `rings = two_bodies`: the left ring, the right one.
+const RING_BODIES: [&str; 2] = ["ring_1", "ring_2"];
 
 /// The registry entry.
 pub const ENTRY: SceneEntry = SceneEntry {
@@ -102,6 +112,13 @@ fn params() -> Vec<Spec> {
             Bound::Positive,
             "distance between the rings' centres (m); more than 2 r_max",
         ),
+        Spec::choice(
+            "rings",
+            &["one_body", "two_bodies"],
+            "one_body",
+            "the rings as one body (shifting and surface across the contact) or as two summing their continuum equations across, each shifting alone (the authors' set-up)",
+        )
+        .added_later(),
     ];
     v.extend(solid_params(&SolidDefaults {
         dx: 0.001,
@@ -213,11 +230,13 @@ pub fn energy(s: &ElasticSolid<2>) -> f64 {
 struct Rings {
     sim: Simulation<2>,
     dx: f64,
-    /// Particles of the left ring: `0..n_left`.
+    /// The bodies holding the rings: [`RINGS`], or the two of [`RING_BODIES`].
+    bodies: &'static [&'static str],
+    /// Particles of the left ring in the first body: `0..n_left`.
     n_left: usize,
-    /// Points A and B.
-    a: usize,
-    b: usize,
+    /// Points A and B: (body, particle).
+    a: (usize, usize),
+    b: (usize, usize),
     /// U(0) and E(0).
     u0: f64,
     e0: f64,
@@ -236,8 +255,13 @@ fn rings(p: &Params) -> Result<Rings, String> {
     let (xl, ml, a) = ring_lattice(-0.5 * sep, -1.0, ri, dx, circles, material.rho0);
     let (xr, mr, b) = ring_lattice(0.5 * sep, 1.0, ri, dx, circles, material.rho0);
     let n_left = xl.len();
-    let mut init = SolidInit::<2>::default();
+    let two = p.str("rings") == "two_bodies";
+    let mut inits = vec![SolidInit::<2>::default()];
     for (side, xs, ms) in [(1.0, xl, ml), (-1.0, xr, mr)] {
+        if two && side < 0.0 {
+            inits.push(SolidInit::default());
+        }
+        let init = inits.last_mut().expect("a ring's body");
         for (x, m) in xs.into_iter().zip(ms) {
             init.x.push(x);
             init.u.push(Vector::<2>::new(side * v_ring, 0.0));
@@ -246,71 +270,104 @@ fn rings(p: &Params) -> Result<Rings, String> {
             init.fixed.push(false);
         }
     }
-    let solid = ElasticSolid::new(RINGS, h, init, material, scheme)?;
+    let names: &'static [&'static str] = if two { &RING_BODIES } else { std::slice::from_ref(&RINGS) };
+    let solids = names
+        .iter()
+        .zip(inits)
+        .map(|(name, init)| ElasticSolid::new(name, h, init, material, scheme).map(Into::into))
+        .collect::<Result<Vec<_>, String>>()?;
     // Room for the rings to travel at twice their speed to tf, and to flatten to twice
     // their size across.
     let reach = 2.0 * v_ring * p.float("tf");
     let (hx, hy) = (0.5 * sep + ro + reach + 10.0 * dx, 2.0 * ro + reach + 10.0 * dx);
     let domain = Domain::bounded([-hx, -hy], [hx, hy]);
-    let sim = simulation("colliding_rings", p, domain, kernel, [solid.into()])?;
+    let across = PairParams { solids: SolidPair::Continuum, ..PairParams::default() };
+    let sim = simulation_with("colliding_rings", p, domain, kernel, solids, |builder| match two {
+        true => builder.couple(RING_BODIES[0], RING_BODIES[1], across),
+        false => builder,
+    })?;
+    let b = if two { (1, b) } else { (0, n_left + b) };
     let mut run = Rings {
         sim,
         dx,
+        bodies: names,
         n_left,
-        a,
-        b: n_left + b,
+        a: (0, a),
+        b,
         u0: 0.0,
         e0: 0.0,
         energy_err: 0.0,
         fracture: fracture::Worst::default(),
     };
     run.u0 = run.u_left();
-    run.e0 = energy(run.solid());
+    run.e0 = run.energy();
     Ok(run)
 }
 
 impl Rings {
-    fn solid(&self) -> &ElasticSolid<2> {
-        self.sim.solid(RINGS).expect("the rings").0
+    /// The solid body `k` of the rings.
+    fn solid(&self, k: usize) -> &ElasticSolid<2> {
+        self.sim.solid(self.bodies[k]).expect("a ring's body").0
+    }
+
+    /// The position of particle `(body, index)`.
+    fn point(&self, (k, i): (usize, usize)) -> Vector<2> {
+        self.solid(k).x[i]
     }
 
     /// U: the x velocity of the left ring's centre of mass.
     fn u_left(&self) -> f64 {
-        let s = self.solid();
+        let s = self.solid(0);
         let (mu, m) = (0..self.n_left).fold((0.0, 0.0), |(mu, m), i| (mu + s.m[i] * s.u[i][0], m + s.m[i]));
         mu / m
     }
 
+    /// Kinetic plus elastic strain energy of both rings.
+    fn energy(&self) -> f64 {
+        (0..self.bodies.len()).map(|k| energy(self.solid(k))).sum()
+    }
+
+    /// Both rings' particle positions, in the order of the bodies.
+    fn positions(&self) -> Vec<Vector<2>> {
+        (0..self.bodies.len()).flat_map(|k| self.solid(k).x.iter().copied()).collect()
+    }
+
     /// Follows the largest energy change at every step.
     fn after_step(&mut self) {
-        let e = energy(self.solid());
+        let e = self.energy();
         self.energy_err = self.energy_err.max((e - self.e0).abs() / self.e0);
     }
 
     fn fracture(&mut self) -> fracture::Fracture {
-        let x = &self.sim.solid(RINGS).expect("the body").0.x;
-        self.fracture.observe(x, self.dx, LINK)
+        let x = self.positions();
+        self.fracture.observe(&x, self.dx, LINK)
     }
 }
 
 impl SceneRun for Rings {
     forward_stepwise!();
     fn plan(&self) -> String {
+        let n_right =
+            if self.bodies.len() == 2 { self.solid(1).len() } else { self.solid(0).len() - self.n_left };
+        let how = match self.bodies.len() {
+            1 => "two rings in one body".to_string(),
+            _ => format!(
+                "two rings as two bodies, {} and {}, summing their continuum equations across, each shifting alone",
+                self.bodies[0], self.bodies[1]
+            ),
+        };
         plan(
             &self.sim,
             &format!(
-                "two rings in one body: {} + {} particles, each at {:.4e} m/s towards the other",
-                self.n_left,
-                self.solid().len() - self.n_left,
-                self.u0
+                "{how}: {} + {n_right} particles, each at {:.4e} m/s towards the other",
+                self.n_left, self.u0
             ),
         )
     }
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let f = self.fracture();
-        let s = self.solid();
-        let (a, b) = (s.x[self.a], s.x[self.b]);
-        let e = energy(s);
+        let (a, b) = (self.point(self.a), self.point(self.b));
+        let e = self.energy();
         vec![
             ("t", self.sim.time()),
             ("ax", a[0]),
@@ -324,11 +381,22 @@ impl SceneRun for Rings {
         ]
     }
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>> {
-        snapshot_bodies(&self.sim, dir, index, Vec::new())
+        if self.bodies.len() == 1 {
+            return snapshot_bodies(&self.sim, dir, index, Vec::new());
+        }
+        // Both rings in one series, as the figures draw them.
+        let name = format!("{RINGS}_{index:05}.vtu");
+        let solids: Vec<_> = self
+            .bodies
+            .iter()
+            .map(|b| (self.sim.solid(b).expect("a ring").0, self.sim.solid_surface(b)))
+            .collect();
+        write_solids(&dir.join(&name), &solids)?;
+        Ok(vec![(RINGS.to_string(), name)])
     }
     fn metrics(&self) -> BTreeMap<String, f64> {
         // The detector at the end too, whatever the sampling.
-        let worst = self.fracture.with(&self.solid().x, self.dx, LINK);
+        let worst = self.fracture.with(&self.positions(), self.dx, LINK);
         let mut m = BTreeMap::from(worst.metrics());
         m.extend([
             ("rebound_speed_ratio".to_string(), -self.u_left() / self.u0),
@@ -336,22 +404,7 @@ impl SceneRun for Rings {
         ]);
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({
-            "sim": &self.sim.state,
-            "energy_err": self.energy_err,
-            "clusters_max": self.fracture.clusters_max,
-            "max_gap": self.fracture.max_gap,
-        })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let get = |k: &str| state[k].clone();
-        let err = |e: serde_json::Error| format!("checkpoint: {e}");
-        self.energy_err = serde_json::from_value(get("energy_err")).map_err(err)?;
-        self.fracture.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
-        self.fracture.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(energy_err, fracture);
 }
 
 #[cfg(test)]
@@ -395,7 +448,7 @@ mod tests {
             p.set_str("colliding_rings", &specs, key, value).unwrap();
         }
         let mut run = rings(&p).unwrap();
-        let c0 = run.solid().material.c0();
+        let c0 = run.solid(0).material.c0();
         assert!((run.u0 - 0.06 * c0).abs() < 1e-9 * c0, "{} {}", run.u0, 0.06 * c0);
         run.advance(3e-4, 0.003, &mut |_, _| true).unwrap();
         assert!((run.u_left() - 0.06 * c0).abs() < 1e-9 * c0, "before contact: {}", run.u_left());
@@ -409,6 +462,34 @@ mod tests {
         assert!(m["max_gap"] < LINK, "{m:?}");
         assert!(m["energy_rel_error"] < 0.2, "{m:?}");
         assert!(run.u_left() < run.u0, "the collision slowed the left ring: {m:?}");
+    }
+
+    /// The rings as two bodies summing across (the authors' set-up) step as the one body
+    /// does, bit for bit, until their kernels reach each other (nothing of one ring is then
+    /// within a support of the other, so every sum, the shifting's included, is the same);
+    /// after the contact they part: the shifting of one ring no longer sees the other.
+    #[test]
+    fn two_bodies_step_as_one_until_the_rings_meet() {
+        let specs = params();
+        let run = |setup: &str, t: f64| {
+            let mut p = Params::defaults(&specs);
+            for (key, value) in [("dx", "0.002"), ("tf", "0.003"), ("separation", "0.09"), ("rings", setup)] {
+                p.set_str("colliding_rings", &specs, key, value).unwrap();
+            }
+            let mut run = rings(&p).unwrap();
+            run.advance(t, 0.003, &mut |_, _| true).unwrap();
+            let bits: Vec<u64> = run.positions().iter().flat_map(|x| x.iter().map(|c| c.to_bits())).collect();
+            (bits, run.u_left(), run.sim.time())
+        };
+        // The outer surfaces 1 cm apart at 0.12 c0 = 13.9 m/s closing: the quintic kernels
+        // (3 h = 6 mm) first meet after 4 mm of closing, 0.29 ms.
+        let (one, _, t1) = run("one_body", 2.5e-4);
+        let (two, _, t2) = run("two_bodies", 2.5e-4);
+        assert_eq!(t1, t2);
+        assert!(one == two, "the set-ups differ before the rings meet");
+        let (one, u1, _) = run("one_body", 0.003);
+        let (two, u2, _) = run("two_bodies", 0.003);
+        assert!(one != two && u1 != u2, "the set-ups agree after the contact");
     }
 
     /// Bad geometry is refused with the key and value named.

@@ -16,12 +16,13 @@
 //! shift_max` (the shifting columns of every scene), with the toe Z
 //! the largest x of the fluid inside the tank, t* = t sqrt(2 g / L) and Z/L.
 
-use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, rms_deviation, scheme_params, shifting_columns,
-    simulation, snapshot_bodies, surface_fields, wall_params, FluidConstants,
-};
+use super::fluid_scheme::{free_surface_params, scheme_params, FluidConstants};
+use super::measure::rms_deviation;
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{shifting_columns, snapshot_bodies, surface_fields};
+use super::stepping::{checkpoint, forward_to_sim, plan, simulation};
 use super::tank::{Column, G, LAYERS};
+use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -194,13 +195,7 @@ impl SceneRun for DamBreak {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "toe": &self.toe })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.toe = serde_json::from_value(state["toe"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(toe);
 }
 
 #[cfg(test)]

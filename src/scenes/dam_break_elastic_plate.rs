@@ -24,7 +24,7 @@
 //! within 1.5 dx; 1 cluster: intact); `particles_lost`, water particles beyond the outer layer of the tank's walls or inside the plate, at the end or at any sample before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
-use super::common::{free_surface_params, scheme_params, wall_params};
+use super::fluid_scheme::{free_surface_params, scheme_params};
 use super::fsi_common::{
     check_lattice, fsi_setup, lattice_words, reference_curve, structure_params, FsiSetup, StructureRun, Watch,
 };
@@ -32,6 +32,7 @@ use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{Probe, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
+use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
@@ -220,7 +221,7 @@ mod tests {
             run.sample();
             assert_eq!(run.watch.metrics(&run.sim, &[])["particles_lost"], 0.0, "water lost by t = {t}");
         }
-        let tip = run.watch.samples.iter().map(|s| s.1).fold(0.0, f64::max);
+        let tip = run.watch.seen.samples.iter().map(|s| s.1).fold(0.0, f64::max);
         assert!(tip > 0.005, "the water has pushed the plate's tip by at most {tip} m");
     }
 

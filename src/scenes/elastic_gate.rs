@@ -30,7 +30,7 @@
 //! before it.
 //! `timeseries.csv`: `t, tip_x, tip_y, max_speed`.
 
-use super::common::{free_surface_params, scheme_params, wall_params};
+use super::fluid_scheme::{free_surface_params, scheme_params};
 use super::fsi_common::{
     check_lattice, fsi_setup, lattice_words, reference_curve, structure_params, FsiSetup, StructureRun, Watch,
 };
@@ -38,6 +38,7 @@ use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::solid_common::{Probe, SolidDefaults};
 use super::tank::{Column, G, LAYERS};
+use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
 

@@ -6,12 +6,13 @@
 //! (found on the surface but not in the outer layer: must be 0), `outer_layer_missed`
 //! (outer-layer particles not found).
 
-use super::common::{
-    check_size, fluid_at_rest, fluid_scheme, forward_to_sim, free_surface_params, plan, restore_sim,
-    scheme_params, simulation, snapshot_bodies, surface_fields, wall_from, FluidConstants,
-};
+use super::fluid_scheme::{fluid_scheme, free_surface_params, scheme_params, FluidConstants};
 use super::geometry::{box_walls, lattice};
+use super::memory::check_size;
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{snapshot_bodies, surface_fields};
+use super::stepping::{checkpoint, forward_to_sim, plan, simulation};
+use super::walls::{fluid_at_rest, wall_from};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -152,10 +153,5 @@ impl SceneRun for Demo {
             ("outer_layer_missed".to_string(), missed as f64),
         ])
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!();
 }

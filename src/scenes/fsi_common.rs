@@ -7,16 +7,17 @@
 //! the fluid with the walls' models (`wall_density`, `wall_pressure`, `wall_viscosity`);
 //! and the checks that the fluid stays out of it.
 
-use super::common::{
-    forward_to_sim, plan, restore_sim, rms_deviation, snapshot_bodies, surface_fields, time_settings,
-    wall_density, wall_pressure, wall_viscosity, FluidConstants,
-};
+use super::fluid_scheme::{time_settings, FluidConstants};
+use super::measure::rms_deviation;
 use super::params::{Params, Spec};
+use super::snapshots::{snapshot_bodies, surface_fields};
 use super::solid_common::{
     check_count, solid_params_as, solid_setup_as, Probe, SolidDefaults, SolidSetup, STRUCTURE,
 };
+use super::stepping::{forward_to_sim, plan, restore_sim};
 use super::tank::LAYERS;
 use super::tank::{Column, RHO0};
+use super::walls::{wall_density, wall_pressure, wall_viscosity};
 use super::SceneRun;
 use crate::solver::fracture;
 use crate::solver::kernel::Kernel;
@@ -25,6 +26,7 @@ use crate::solver::nnps::Domain;
 use crate::solver::scheme::FluidScheme;
 use crate::solver::simulation::{Simulation, Substeps, TimeSettings};
 use crate::solver::systems::{Body, BoundaryMaterial, ElasticSolid, SolidInit};
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -243,12 +245,21 @@ pub struct Watch {
     pub body: &'static str,
     /// Its followed point.
     pub tip: Probe,
-    /// (t, tip_x, tip_y) samples.
-    pub samples: Vec<(f64, f64, f64)>,
-    lost_max: usize,
-    fracture: fracture::Worst,
+    /// What it has seen, the part of a checkpoint it keeps.
+    pub seen: Seen,
     /// The tank's width and the particle spacing.
     tank: (f64, f64),
+}
+
+/// What a [`Watch`] has seen over a run.
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Seen {
+    /// (t, tip_x, tip_y) samples.
+    pub samples: Vec<(f64, f64, f64)>,
+    /// The most water particles found lost at a sample.
+    pub lost_max: usize,
+    /// The fracture detector's worst.
+    pub fracture: fracture::Worst,
 }
 
 /// A published curve a metric measures the run against: the metric's name, the component
@@ -262,14 +273,7 @@ pub const LINK: f64 = 1.5;
 impl Watch {
     /// Follows `tip` of structure `body` in a tank `tank_width` wide (spacing `dx`).
     pub fn new(body: &'static str, tip: Probe, (tank_width, dx): (f64, f64)) -> Self {
-        Self {
-            body,
-            tip,
-            samples: Vec::new(),
-            lost_max: 0,
-            fracture: Default::default(),
-            tank: (tank_width, dx),
-        }
+        Self { body, tip, seen: Seen::default(), tank: (tank_width, dx) }
     }
 
     fn solid<'a>(&self, sim: &'a Simulation<2>) -> &'a ElasticSolid<2> {
@@ -284,9 +288,9 @@ impl Watch {
     /// One time-series row, `t, tip_x, tip_y, max_speed`, recorded.
     pub fn sample(&mut self, sim: &Simulation<2>) -> Vec<(&'static str, f64)> {
         let (t, d) = (sim.time(), self.tip.displacement(self.solid(sim)));
-        self.samples.push((t, d[0], d[1]));
-        self.lost_max = self.lost_max.max(self.lost(sim));
-        self.fracture.observe(&self.solid(sim).x, self.tank.1, LINK);
+        self.seen.samples.push((t, d[0], d[1]));
+        self.seen.lost_max = self.seen.lost_max.max(self.lost(sim));
+        self.seen.fracture.observe(&self.solid(sim).x, self.tank.1, LINK);
         vec![("t", t), ("tip_x", d[0]), ("tip_y", d[1]), ("max_speed", sim.max_speed())]
     }
 
@@ -294,10 +298,10 @@ impl Watch {
     /// deviation of `tip_x` (component 0) or `tip_y` (1) from each published curve.
     pub fn metrics(&self, sim: &Simulation<2>, published: &[Published]) -> BTreeMap<String, f64> {
         let mut m =
-            BTreeMap::from([("particles_lost".to_string(), self.lost_max.max(self.lost(sim)) as f64)]);
-        m.extend(self.fracture.with(&self.solid(sim).x, self.tank.1, LINK).metrics());
+            BTreeMap::from([("particles_lost".to_string(), self.seen.lost_max.max(self.lost(sim)) as f64)]);
+        m.extend(self.seen.fracture.with(&self.solid(sim).x, self.tank.1, LINK).metrics());
         let series = |k: usize| -> Vec<(f64, f64)> {
-            self.samples.iter().map(|s| (s.0, if k == 0 { s.1 } else { s.2 })).collect()
+            self.seen.samples.iter().map(|s| (s.0, if k == 0 { s.1 } else { s.2 })).collect()
         };
         for (k, name) in [(0, "tip_x_max"), (1, "tip_y_max")] {
             if let Some(max) = series(k).iter().map(|s| s.1).reduce(f64::max) {
@@ -310,20 +314,6 @@ impl Watch {
             }
         }
         m
-    }
-
-    /// What a checkpoint keeps of it.
-    pub fn save(&self) -> serde_json::Value {
-        serde_json::json!({ "samples": &self.samples, "lost_max": self.lost_max, "fracture": self.fracture })
-    }
-
-    /// Restores what [`save`](Self::save) kept.
-    pub fn load(&mut self, state: &serde_json::Value) -> Result<(), String> {
-        let bad = |e: serde_json::Error| format!("checkpoint: {e}");
-        self.samples = serde_json::from_value(state["samples"].clone()).map_err(bad)?;
-        self.lost_max = serde_json::from_value(state["lost_max"].clone()).map_err(bad)?;
-        self.fracture = serde_json::from_value(state["fracture"].clone()).map_err(bad)?;
-        Ok(())
     }
 }
 
@@ -361,10 +351,11 @@ impl SceneRun for StructureRun {
         self.watch.metrics(&self.sim, &self.published)
     }
     fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "watch": self.watch.save() })
+        serde_json::json!({ "sim": &self.sim.state, "watch": &self.watch.seen })
     }
     fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.watch.load(&state["watch"])?;
+        self.watch.seen = serde_json::from_value(state["watch"].clone())
+            .map_err(|e| format!("checkpoint: `watch`: {e}"))?;
         restore_sim(&mut self.sim, &state)
     }
 }

@@ -31,11 +31,10 @@
 //! `timeseries.csv`: `t, projectile_y, projectile_v, hole_width_mm` (the projectile's centre
 //! of mass and its speed, and the hole by the rule above at that time).
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
-};
+use super::snapshots::snapshot_bodies;
+use super::solid_common::{check_count, solid_params, solid_setup, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
@@ -225,12 +224,7 @@ impl SceneRun for Impact {
     fn metrics(&self) -> BTreeMap<String, f64> {
         BTreeMap::from([("hole_width_mm".to_string(), self.hole_width_mm())])
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!();
 }
 
 #[cfg(test)]

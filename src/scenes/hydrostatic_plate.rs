@@ -37,17 +37,17 @@
 //! inside the plate
 //! at the end. `timeseries.csv`: `t, midspan_y, max_speed`.
 
-use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, snapshot_bodies, surface_fields,
-    wall_params,
-};
+use super::fluid_scheme::{free_surface_params, scheme_params};
 use super::fsi_common::{
     check_lattice, fluid_inside, fluid_outside, fsi_setup, lattice_words, structure_params, FsiSetup,
 };
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{snapshot_bodies, surface_fields};
 use super::solid_common::{Probe, SolidDefaults};
+use super::stepping::{checkpoint, forward_to_sim, plan};
 use super::tank::{Column, LAYERS, RHO0};
+use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
 use crate::solver::simulation::Simulation;
@@ -251,14 +251,7 @@ impl SceneRun for HydrostaticPlate {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "samples": &self.samples })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.samples =
-            serde_json::from_value(state["samples"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(samples);
 }
 
 #[cfg(test)]

@@ -12,12 +12,12 @@
 //! the fluid particles found beyond the wall surfaces (none may be). The free surface is detected every step (CTVF sec. 3.4) and any shifting
 //! kept tangential near it (sec. 3.5); the default runs without shifting (`pst = none`).
 
-use super::common::{
-    forward_to_sim, free_surface_params, plan, restore_sim, scheme_params, shifting_columns, simulation,
-    snapshot_bodies, wall_params, FluidConstants,
-};
+use super::fluid_scheme::{free_surface_params, scheme_params, FluidConstants};
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{shifting_columns, snapshot_bodies};
+use super::stepping::{checkpoint, forward_to_sim, plan, simulation};
 use super::tank::{Column, G, LAYERS, RHO0};
+use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -172,12 +172,7 @@ impl SceneRun for Tank {
             ("particles_outside".to_string(), outside as f64),
         ])
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!();
 }
 
 #[cfg(test)]

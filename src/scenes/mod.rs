@@ -6,10 +6,10 @@
 pub mod cavity;
 pub mod clamped_beam_udl;
 pub mod colliding_rings;
-pub mod common;
 pub mod dam_break;
 pub mod dam_break_elastic_plate;
 pub mod elastic_gate;
+pub mod fluid_scheme;
 pub mod free_surface_demo;
 pub mod fsi_common;
 pub mod geometry;
@@ -17,14 +17,19 @@ pub mod harness;
 pub mod high_velocity_impact;
 pub mod hydrostatic_plate;
 pub mod hydrostatic_tank;
+pub mod measure;
+pub mod memory;
 pub mod oscillating_plate;
 pub mod params;
 pub mod progress;
+pub mod snapshots;
 pub mod solid_common;
+pub mod stepping;
 pub mod tank;
 pub mod taylor_green;
 pub mod turek_csm3;
 pub mod uniaxial_compression;
+pub mod walls;
 
 use crate::solver::simulation::Divergence;
 use params::{Params, Spec};
@@ -146,7 +151,7 @@ impl SceneEntry {
         // a case, defaults included, and its problem file was checked with the keys it gives.
         let defaults = Params::defaults(&specs);
         let given = |k: &str| given.contains_key(k) && p.0.get(k) != defaults.0.get(k);
-        if let Some(e) = common::unused_scheme_option(&p, given) {
+        if let Some(e) = fluid_scheme::unused_scheme_option(&p, given) {
             return Err(format!("scene `{}`: parameter `{}` = {} {}", self.name, e.key, p.0[e.key], e.why));
         }
         Ok(p)

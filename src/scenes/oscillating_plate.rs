@@ -32,11 +32,10 @@
 //!
 //! `timeseries.csv`: `t, tip_y, clusters, max_gap`.
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
-};
+use super::snapshots::snapshot_bodies;
+use super::solid_common::{solid_params, solid_setup, BlockSetup, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::fracture;
 use crate::solver::math::Vector;
@@ -101,15 +100,7 @@ fn params() -> Vec<Spec> {
 }
 
 /// What the parameters make, once every check that needs no particle has passed.
-struct Setup {
-    solid: SolidSetup,
-    /// Plate columns and rows, and clamp layers.
-    nx: usize,
-    ny: usize,
-    layers: usize,
-}
-
-fn setup(p: &Params) -> Result<Setup, String> {
+fn setup(p: &Params) -> Result<BlockSetup, String> {
     let scene = "oscillating_plate";
     if p.float("vf") >= 1.0 {
         return Err(format!(
@@ -122,17 +113,9 @@ fn setup(p: &Params) -> Result<Setup, String> {
         .unwrap_or(0.0);
     let u = p.float("vf") * c0;
     let solid = solid_setup(scene, p, (u, "`vf`"), u, [0.0; 3])?;
-    let dx = solid.dx;
     let (l, hp) = (p.float("length"), p.float("height"));
-    // In floating point first: a spacing of 1e-300 m must not overflow a count.
-    let (nxf, nyf) = ((l / dx).round(), (hp / dx).round());
-    let plate = format!("the plate (`length` = {l:?}, `height` = {hp:?}) at `dx` = {dx:?}");
-    if nyf < 2.0 || nxf < 4.0 {
-        return Err(format!("scene `{scene}`: {plate} has fewer than 4 x 2 particles"));
-    }
-    check_count(scene, &plate, nxf * nyf)?;
-    let layers = solid.support_layers();
-    Ok(Setup { solid, nx: nxf as usize, ny: nyf as usize, layers })
+    let plate = format!("the plate (`length` = {l:?}, `height` = {hp:?}) at `dx` = {:?}", solid.dx);
+    solid.block(scene, &plate, (l, hp), (4.0, 2.0))
 }
 
 /// Eq. (67): the shape of the first bending mode of a clamped-free plate, `k = kL / L`.
@@ -179,7 +162,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 }
 
 fn plate(p: &Params) -> Result<Plate, String> {
-    let Setup { solid: SolidSetup { material, scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
+    let BlockSetup { solid: SolidSetup { material, scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
     let (l, hp) = (nx as f64 * dx, ny as f64 * dx);
     let (k, c0, vf) = (KL / l, material.c0(), p.float("vf"));
     let f_l = mode_shape(l, k, l);
@@ -300,24 +283,7 @@ impl SceneRun for Plate {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({
-            "sim": &self.sim.state,
-            "last": self.last,
-            "crossings": &self.crossings,
-            "clusters_max": self.fracture.clusters_max,
-            "max_gap": self.fracture.max_gap,
-        })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let get = |k: &str| state[k].clone();
-        let err = |e: serde_json::Error| format!("checkpoint: {e}");
-        self.last = serde_json::from_value(get("last")).map_err(err)?;
-        self.crossings = serde_json::from_value(get("crossings")).map_err(err)?;
-        self.fracture.clusters_max = serde_json::from_value(get("clusters_max")).map_err(err)?;
-        self.fracture.max_gap = serde_json::from_value(get("max_gap")).map_err(err)?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(last, crossings, fracture);
 }
 
 #[cfg(test)]

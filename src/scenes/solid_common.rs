@@ -1,9 +1,9 @@
 //! What the elastic-solid scenes share: the material and scheme parameters every one of
 //! them takes (`dx`, `hdx`, `youngs_modulus`, `poisson_ratio`, `density`, `yield_stress`
 //! where plastic, `alpha`, `scheme`, `pst`, `corrections`), their checks by key before any
-//! particle is made, and the [`SolidSetup`] they give; plus the step-by-step advance a
-//! solid scene uses to follow its probes at every step ([`forward_stepwise`]), and the
-//! extremum detector that reads an oscillation from them ([`Extrema`]).
+//! particle is made, and the [`SolidSetup`] they give (with a rectangular block's,
+//! [`BlockSetup`]); plus a point of a solid followed over a run ([`Probe`]) and the extremum
+//! detector that reads an oscillation from it ([`Extrema`]).
 
 use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
@@ -225,6 +225,42 @@ pub fn solid_setup_as(
     Ok(SolidSetup { material, scheme, kernel, dx, h })
 }
 
+/// A solid scene's set-up for a rectangular block of particles (a plate, a beam, a flag):
+/// the solid's [`SolidSetup`], the block's columns and rows, and the layers of a clamp.
+#[derive(Clone, Debug)]
+pub struct BlockSetup {
+    /// The solid's set-up.
+    pub solid: SolidSetup,
+    /// Columns.
+    pub nx: usize,
+    /// Rows.
+    pub ny: usize,
+    /// Kernel support layers at the spacing: how deep a clamp must be.
+    pub layers: usize,
+}
+
+impl SolidSetup {
+    /// The block of `length` x `height` (m) at this spacing (`round(length / dx)` columns and
+    /// `round(height / dx)` rows), named `what` in errors: refused when it has fewer than
+    /// `min` (columns, rows) particles or more than [`check_count`] allows. The counts are
+    /// taken in floating point first: a spacing of 1e-300 m must not overflow them.
+    pub fn block(
+        self,
+        scene: &str,
+        what: &str,
+        (length, height): (f64, f64),
+        min: (f64, f64),
+    ) -> Result<BlockSetup, String> {
+        let (nxf, nyf) = ((length / self.dx).round(), (height / self.dx).round());
+        if nxf < min.0 || nyf < min.1 {
+            return Err(format!("scene `{scene}`: {what} has fewer than {} x {} particles", min.0, min.1));
+        }
+        check_count(scene, what, nxf * nyf)?;
+        let layers = self.support_layers();
+        Ok(BlockSetup { solid: self, nx: nxf as usize, ny: nyf as usize, layers })
+    }
+}
+
 /// A particle count in floating point first, refused beyond 5e6 particles (a spacing of
 /// 1e-300 m must not overflow a count).
 pub fn check_count(scene: &str, what: &str, count: f64) -> Result<(), String> {
@@ -296,37 +332,6 @@ impl Extrema {
         Some((0.5 * (peak + low), 0.5 * (peak - low), 1.0 / (t2 - t1)))
     }
 }
-
-/// The [`SceneRun`](super::SceneRun) methods of a scene whose state is `self.sim`, with an
-/// advance that steps one step at a time and calls `self.after_step()` after each (to
-/// follow probes, crossings or extrema at every step).
-macro_rules! forward_stepwise {
-    () => {
-        $crate::scenes::common::forward_counts!();
-        fn advance(
-            &mut self,
-            t_stop: f64,
-            t_end: f64,
-            on_step: &mut dyn FnMut(f64, u64) -> bool,
-        ) -> Result<bool, $crate::solver::simulation::Divergence> {
-            let eps = 1e-12 * t_end.abs().max(1.0);
-            loop {
-                let now = self.sim.time();
-                if now >= t_stop - eps || t_end - now <= eps {
-                    return Ok(true);
-                }
-                // As `Simulation::advance` does: only the step that would pass t_end is
-                // shortened.
-                self.sim.step(t_end - now)?;
-                self.after_step();
-                if !on_step(self.sim.time(), self.sim.steps()) {
-                    return Ok(false);
-                }
-            }
-        }
-    };
-}
-pub(crate) use forward_stepwise;
 
 /// A point of a solid followed over a run: the mean position of some of its particles,
 /// and its displacement from where it started.

@@ -4,12 +4,13 @@
 //! continuity density ([`FluidConstants::under_gravity`]), the fluid at the hydrostatic
 //! pressure `rho0 g (H - y)`.
 
-use super::common::{
-    check_size, check_wall_layers, fluid_at_rest, fluid_scheme, require_free_surface_scheme, wall_density,
-    wall_from, wall_pressure, wall_viscosity, FluidConstants,
-};
+use super::fluid_scheme::{fluid_scheme, require_free_surface_scheme, FluidConstants};
 use super::geometry::{box_walls, lattice};
+use super::memory::check_size;
 use super::params::Params;
+use super::walls::{
+    check_wall_layers, fluid_at_rest, wall_density, wall_from, wall_pressure, wall_viscosity,
+};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
 use crate::solver::scheme::FluidScheme;

@@ -19,11 +19,11 @@
 //! - `p_l1_final`: mean |(p - mean p) - (p_e - mean p_e)| over max |p_e| at tf;
 //! - `kinetic_energy_rel_error`: |KE - KE_exact| / KE_exact at tf, KE = sum m |u|^2 / 2.
 
-use super::common::{
-    check_size, fluid_scheme, forward_to_sim, plan, restore_sim, scheme_params, shifting_columns,
-    snapshot_bodies, FluidConstants,
-};
+use super::fluid_scheme::{fluid_scheme, scheme_params, FluidConstants};
+use super::memory::check_size;
 use super::params::{Bound, Params, Spec};
+use super::snapshots::{shifting_columns, snapshot_bodies};
+use super::stepping::{checkpoint, forward_to_sim, plan};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::kernel::Kernel;
 use crate::solver::math::Vector;
@@ -255,7 +255,7 @@ pub fn simulation<const D: usize>(p: &Params) -> Result<Simulation<D>, String> {
         }
     }
     let fluid = Fluid::new("fluid", h, init, scheme)?;
-    super::common::simulation(name::<D>(), p, domain, kernel, [fluid.into()])
+    super::stepping::simulation(name::<D>(), p, domain, kernel, [fluid.into()])
 }
 
 /// Parameters of this scene from `key=value` strings over the defaults.
@@ -318,13 +318,7 @@ impl<const D: usize> SceneRun for TaylorGreen<D> {
     fn plan(&self) -> String {
         plan(&self.sim, &self.setting)
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "l1": self.l1 })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.l1 = serde_json::from_value(state["l1"].clone()).map_err(|e| format!("checkpoint: l1: {e}"))?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(l1);
     fn sample(&mut self) -> Vec<(&'static str, f64)> {
         let e = self.errors();
         self.l1 = self.l1.with(self.sim.time(), e.l1);

@@ -41,11 +41,10 @@
 //!
 //! `timeseries.csv`: `t, tip_x, tip_y`.
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, Extrema, SolidDefaults, SolidSetup,
-};
+use super::snapshots::snapshot_bodies;
+use super::solid_common::{solid_params, solid_setup, BlockSetup, Extrema, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::math::Vector;
 use crate::solver::nnps::Domain;
@@ -114,14 +113,7 @@ fn params() -> Vec<Spec> {
 }
 
 /// What the parameters make, once every check that needs no particle has passed.
-struct Setup {
-    solid: SolidSetup,
-    nx: usize,
-    ny: usize,
-    layers: usize,
-}
-
-fn setup(p: &Params) -> Result<Setup, String> {
+fn setup(p: &Params) -> Result<BlockSetup, String> {
     let scene = "turek_csm3";
     let (l, hf, g) = (p.float("length"), p.float("height"), p.float("gravity"));
     if hf > 2.0 * CYLINDER.1 {
@@ -133,15 +125,8 @@ fn setup(p: &Params) -> Result<Setup, String> {
     // The largest speed: free fall over the flag's length, sqrt(2 g l).
     let u = (2.0 * g * l).sqrt();
     let solid = solid_setup(scene, p, (u, "`gravity` and `length`"), u.max(1e-3), [0.0, -g, 0.0])?;
-    let dx = solid.dx;
-    let (nxf, nyf) = ((l / dx).round(), (hf / dx).round());
-    let flag = format!("the flag (`length` = {l:?}, `height` = {hf:?}) at `dx` = {dx:?}");
-    if nyf < 2.0 || nxf < 4.0 {
-        return Err(format!("scene `{scene}`: {flag} has fewer than 4 x 2 particles"));
-    }
-    check_count(scene, &flag, nxf * nyf)?;
-    let layers = solid.support_layers();
-    Ok(Setup { solid, nx: nxf as usize, ny: nyf as usize, layers })
+    let flag = format!("the flag (`length` = {l:?}, `height` = {hf:?}) at `dx` = {:?}", solid.dx);
+    solid.block(scene, &flag, (l, hf), (4.0, 2.0))
 }
 
 struct Flag {
@@ -158,7 +143,7 @@ fn build(p: &Params) -> Result<Box<dyn SceneRun>, String> {
 }
 
 fn flag(p: &Params) -> Result<Flag, String> {
-    let Setup { solid: SolidSetup { material, scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
+    let BlockSetup { solid: SolidSetup { material, scheme, kernel, dx, h }, nx, ny, layers } = setup(p)?;
     let ([cx, cy], r) = CYLINDER;
     let (l, hf) = (nx as f64 * dx, ny as f64 * dx);
     let x_attach = cx + r;
@@ -251,14 +236,7 @@ impl SceneRun for Flag {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "extrema": &self.extrema })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        self.extrema =
-            serde_json::from_value(state["extrema"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(extrema);
 }
 
 #[cfg(test)]

@@ -35,11 +35,10 @@
 //!
 //! `timeseries.csv`: `t, strain, von_mises_center, von_mises_elastic`.
 
-use super::common::{plan, restore_sim, simulation, snapshot_bodies};
 use super::params::{Bound, Params, Spec};
-use super::solid_common::{
-    check_count, forward_stepwise, solid_params, solid_setup, SolidDefaults, SolidSetup,
-};
+use super::snapshots::snapshot_bodies;
+use super::solid_common::{check_count, solid_params, solid_setup, SolidDefaults, SolidSetup};
+use super::stepping::{checkpoint, forward_stepwise, plan, simulation};
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::equations::solid::von_mises_principal;
 use crate::solver::math::{Matrix, Vector};
@@ -246,15 +245,7 @@ impl SceneRun for Compression {
         }
         m
     }
-    fn save_state(&self) -> serde_json::Value {
-        serde_json::json!({ "sim": &self.sim.state, "sums": [self.sum_error, self.sum_elastic] })
-    }
-    fn load_state(&mut self, state: serde_json::Value) -> Result<(), String> {
-        let sums: [f64; 2] =
-            serde_json::from_value(state["sums"].clone()).map_err(|e| format!("checkpoint: {e}"))?;
-        [self.sum_error, self.sum_elastic] = sums;
-        restore_sim(&mut self.sim, &state)
-    }
+    checkpoint!(sum_error, sum_elastic);
 }
 
 #[cfg(test)]

@@ -218,7 +218,7 @@ impl Expand<'_> {
             for p in combos {
                 let cname = case_name(g.name.as_deref(), &set_keys, &p)
                     .map_err(|e| loc.err(gspan.clone(), "cases.name", e))?;
-                if let Some(e) = scenes::common::unused_scheme_option(&p, given) {
+                if let Some(e) = scenes::fluid_scheme::unused_scheme_option(&p, given) {
                     return Err(loc.err(
                         gspan.clone(),
                         e.key,

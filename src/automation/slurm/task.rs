@@ -120,12 +120,9 @@ pub fn run(path: &Path, index: Option<usize>) -> u8 {
     if let Some(c) = manifest.checkpoint_every {
         cmd.arg("--checkpoint-every").arg(c.to_string());
     }
+    // The simulation holds the case's lock this task took, as under the local runner.
     #[cfg(unix)]
-    {
-        // The simulation holds the case's lock this task took, as under the local runner.
-        cmd.arg("--lock-fd").arg(lock.inherit_fd().to_string());
-        hand_down(&mut cmd, lock.inherit_fd());
-    }
+    lock.hand_down(&mut cmd);
     crate::outln!("simulating {}/{} with {threads} thread(s)", case.problem, case.case);
     let mut child = match cmd.spawn() {
         Ok(c) => c,
@@ -220,36 +217,5 @@ fn install_warning_handler() {
             TIME_UP.store(true, Ordering::SeqCst);
         }
         libc::signal(libc::SIGUSR1, on_warning as extern "C" fn(libc::c_int) as libc::sighandler_t);
-    }
-}
-
-/// Hands the case's lock down to the simulation (it inherits the open file, so the case
-/// stays locked while either lives) and stops the simulation with a checkpoint (SIGUSR1,
-/// Linux) if this task dies first.
-#[cfg(unix)]
-fn hand_down(cmd: &mut std::process::Command, lock_fd: std::os::unix::io::RawFd) {
-    use std::os::unix::process::CommandExt;
-    #[cfg(target_os = "linux")]
-    // SAFETY: getpid is async-signal-safe and called before the fork.
-    let parent = unsafe { libc::getpid() };
-    // SAFETY: between fork and exec only async-signal-safe calls (fcntl, prctl, getppid)
-    // on a descriptor this process owns.
-    unsafe {
-        cmd.pre_exec(move || {
-            let flags = libc::fcntl(lock_fd, libc::F_GETFD);
-            if flags < 0 || libc::fcntl(lock_fd, libc::F_SETFD, flags & !libc::FD_CLOEXEC) < 0 {
-                return Err(std::io::Error::last_os_error());
-            }
-            #[cfg(target_os = "linux")]
-            {
-                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGUSR1) < 0 {
-                    return Err(std::io::Error::last_os_error());
-                }
-                if libc::getppid() != parent {
-                    return Err(std::io::Error::other("the task has exited"));
-                }
-            }
-            Ok(())
-        });
     }
 }

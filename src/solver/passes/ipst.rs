@@ -6,7 +6,7 @@
 //! geometry ([`Slabs`]), so that its sums, too, do not depend on the thread count.
 //!
 //! The sweeps and moves of all the iterations run as stages of the slabs on the threads of
-//! the pool ([`stages`](crate::solver::schedule::stages)), a slab's next sweep starting once
+//! the pool ([`stages`](crate::solver::stages)), a slab's next sweep starting once
 //! the slabs around it have moved, rather than as two parallel loops a sweep: on two
 //! threads each loop lost some 20 microseconds to its join, and the moves took 1.5x their
 //! one-thread time, about a tenth of IPST's time in all.
@@ -22,8 +22,8 @@ use crate::solver::interactions::lists::KernelList;
 use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::Vector;
 use crate::solver::nnps::{CellList, Gather, HalfPairs, PairSlices, Slabs};
-use crate::solver::schedule::stages::{run_stages, Board, Grid, Tiled};
 use crate::solver::scheme::{IpstTest, Shifting};
+use crate::solver::stages::{run_stages, Board, Grid, Tiled};
 use crate::solver::LIGHT_LOOP_LEN;
 use rayon::prelude::*;
 use std::ops::Range;
@@ -641,8 +641,8 @@ mod tests {
     use super::*;
     use crate::solver::interactions::lists::build_kernel_list;
     use crate::solver::passes::{accelerations, FluidPasses};
-    use crate::solver::schedule::stages::take_turns;
     use crate::solver::scheme::{FluidScheme, FluidSettings, Pst, SchemeName};
+    use crate::solver::stages::take_turns;
     use crate::solver::systems::{Fluid, FluidInit, FluidRates};
 
     /// IPST's board runs each sweep and each move of every slab once, after its inputs:

@@ -2,14 +2,12 @@
 //! the threads. None of it changes a result: every order of addition is fixed by the
 //! passes themselves.
 //!
-//! - [`wavefront`]: a step's gather passes tile by tile, the fast path of a scene of one
+//! - [`wavefront`]: a step's gather passes tile by tile (on the stage runner of
+//!   [`stages`](crate::solver::stages)), the fast path of a scene of one
 //!   fluid body;
 //! - [`tuner`]: which of the sweeps and the wavefront a run keeps, timed on its first steps;
-//! - [`stages`]: the stages of tiles or slabs run on the threads of the pool as their inputs
-//!   are done (the wavefront's and IPST's sweeps);
 //! - [`warm`]: the pool's workers kept awake while a run steps.
 
-pub mod stages;
 pub mod tuner;
 pub mod warm;
 pub mod wavefront;

@@ -36,7 +36,6 @@
 //! wavefront, depends on the host's cache, the scheme and the threads, so by default a run
 //! times both on its first steps and keeps the faster ([`Schedule`], [`Tuner`]).
 
-use super::stages::{run_stages, Grid, Tiled, WHOLE_TILE};
 use crate::solver::equations::Point;
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::fluid_fluid::{FluidFluid, RateTerms};
@@ -47,6 +46,7 @@ use crate::solver::passes::accelerations::{shifting_dt, write_accelerations, wri
 use crate::solver::passes::rates::pressure_rates;
 use crate::solver::passes::{set_and_regather, FluidPasses, FluidViews, Sources};
 use crate::solver::scheme::{DensityModel, FluidScheme, PressureModel, PressureReference};
+use crate::solver::stages::{run_stages, Grid, Tiled, WHOLE_TILE};
 use crate::solver::systems::{Fluid, FluidRates};
 use std::collections::VecDeque;
 use std::ops::Range;
@@ -283,7 +283,7 @@ fn pick(g: &Grid, tiles: Range<usize>) -> Option<usize> {
     })
 }
 
-impl super::stages::Board for Board {
+impl crate::solver::stages::Board for Board {
     type Task = Task;
     type Out = ();
 
@@ -416,10 +416,10 @@ impl Wavefront {
 
 #[cfg(test)]
 mod tests {
-    use super::super::stages::take_turns;
     use super::*;
     use crate::solver::math::Vector;
     use crate::solver::nnps::{Domain, NeighbourList};
+    use crate::solver::stages::take_turns;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 

@@ -42,7 +42,7 @@ pub struct FluidSettings {
     /// Gravity.
     pub gravity: [f64; 3],
     /// The reference pressure of the pressure gradient (`Auto` also depends on the walls,
-    /// which [`Simulation::new`](crate::solver::simulation::Simulation::new) resolves).
+    /// which the simulation's builder resolves, [`FluidScheme::resolve_reference`]).
     pub pressure_reference: PressureReference,
     /// A free surface to detect (sec. 3.4-3.5), with what its particles' pressure does.
     pub free_surface: Option<SurfacePressure>,

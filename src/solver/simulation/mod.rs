@@ -34,8 +34,12 @@
 //! from it: momentum crosses the interface without loss, whatever `n`.
 //!
 //! **Particles that come and go.** A body can lose particles ([`Simulation::retain`]) or gain
-//! them ([`Simulation::extend`]) between steps: the survivors keep their rates, the new ones
-//! start with none, and the binning and every neighbour list are made again.
+//! them ([`Simulation::extend`]) between steps: the binning and every neighbour list are made
+//! again. The survivors keep the rates of the last evaluation for the next opening kick, as
+//! kick-drift-kick reuses them (a removed particle's force on its neighbours acts for that
+//! half kick, the reaction of the closing kick it took); the new particles start with none,
+//! and feel forces from the next evaluation on, half a step later. Particles the change
+//! does not reach step as they would have, bit for bit.
 
 mod builder;
 
@@ -297,12 +301,19 @@ impl<const D: usize> Simulation<D> {
             false
         });
         self.state.u_max = self.max_speed();
+        self.rates_at_rest(0);
+    }
+
+    /// The rates of every body at the current state, on the lists just made, for the next
+    /// step's opening kick (step number `next_step`): as at the start of a run, the
+    /// summation density, a state equation's pressure, the accelerations and the shifting,
+    /// and the forces held over the sub-steps.
+    fn rates_at_rest(&mut self, next_step: u64) {
         let (dt, n) = self.step_sizes();
         self.evaluate(0.0, true);
-        self.accelerate(Clock::Main, false, dt, 0);
+        self.accelerate(Clock::Main, false, dt, next_step);
         self.exchange(None);
-        let dt_own = dt / n as f64;
-        self.accelerate(Clock::Own, false, dt_own, 0);
+        self.accelerate(Clock::Own, false, dt / n as f64, next_step);
     }
 
     /// The evaluations of the bodies on the main clock up to their free surfaces: the
@@ -343,7 +354,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Removes the particles of body `name` for which `keep` (given the particle's index)
     /// is false, between steps: the survivors keep their rates; the binning and every list
-    /// are made again. Errors for no such body, a body whose particles cannot change (a
+    /// are made again (see the module's documentation). Errors for no such body, a body whose particles cannot change (a
     /// wall, a structure a fluid reads), or one that would be left empty.
     pub fn retain(&mut self, name: &str, keep: impl Fn(usize) -> bool) -> Result<usize, String> {
         let k = self.index_of(name)?;
@@ -384,7 +395,7 @@ impl<const D: usize> Simulation<D> {
         })
     }
 
-    /// After a change of particles: every body binned again (a fluid sorted), every list
+    /// After a change of particles: every body binned again (a fluid sorted) and every list
     /// made again.
     fn rebuild(&mut self) {
         self.each(On::All, false, |s, w, i| {
@@ -656,24 +667,14 @@ impl<const D: usize> Simulation<D> {
     /// Steps until the time reaches `t_stop` (without shortening steps for it, so output
     /// times never change the solution), shortening only the step that would pass `t_end`,
     /// or until `on_step` (called after every step) returns false. Returns whether `t_stop`
-    /// was reached.
+    /// was reached. (The loop is [`step_until`]'s.)
     pub fn advance(
         &mut self,
         t_stop: f64,
         t_end: f64,
         mut on_step: impl FnMut(&Self) -> bool,
     ) -> Result<bool, Divergence> {
-        let eps = 1e-12 * t_end.abs().max(1.0);
-        crate::solver::schedule::warm::keep_warm(|| loop {
-            let remaining = t_end - self.state.time;
-            if self.state.time >= t_stop - eps || remaining <= eps {
-                return Ok(true);
-            }
-            self.step(remaining)?;
-            if !on_step(self) {
-                return Ok(false);
-            }
-        })
+        step_until(self, |s| s, (t_stop, t_end), |s| on_step(s))
     }
 
     /// Largest fluid particle speed (0 without a fluid).
@@ -713,6 +714,33 @@ impl<const D: usize> Simulation<D> {
     pub fn positions(&self) -> &[Vector<D>] {
         &self.fluid().x
     }
+}
+
+/// The stepping loop of every run: steps the simulation `sim(owner)` until its time reaches
+/// `t_stop` (without shortening steps for it, so output times never change the solution),
+/// shortening only the step that would pass `t_end`, and calls `after_step(owner)` after every
+/// step, until it returns false (a scene following its probes at every step passes itself as
+/// `owner`). Returns whether `t_stop` was reached. The pool's workers are kept warm while it
+/// steps ([`keep_warm`](crate::solver::schedule::warm::keep_warm)): a loop of its own would
+/// wake them at every parallel pass.
+pub fn step_until<S, const D: usize>(
+    owner: &mut S,
+    sim: fn(&mut S) -> &mut Simulation<D>,
+    (t_stop, t_end): (f64, f64),
+    mut after_step: impl FnMut(&mut S) -> bool,
+) -> Result<bool, Divergence> {
+    let eps = 1e-12 * t_end.abs().max(1.0);
+    crate::solver::schedule::warm::keep_warm(|| loop {
+        let s = sim(owner);
+        let remaining = t_end - s.state.time;
+        if s.state.time >= t_stop - eps || remaining <= eps {
+            return Ok(true);
+        }
+        s.step(remaining)?;
+        if !after_step(owner) {
+            return Ok(false);
+        }
+    })
 }
 
 /// A box of margin four radii around the points `x`: a body's binning within one step, over

@@ -7,8 +7,10 @@ use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::kernel::KernelKind;
 use crate::solver::passes::{rates, FluidPasses};
 use crate::solver::schedule::Wavefront;
-use crate::solver::scheme::{FluidSettings, Pst, SchemeName, Shifting, Transport};
-use crate::solver::systems::{FluidInit, FluidWork};
+use crate::solver::scheme::{
+    Corrections, FluidSettings, Pst, SchemeName, Shifting, SolidSchemeName, SolidSettings, Transport,
+};
+use crate::solver::systems::{FluidInit, FluidWork, SolidInit, SolidMaterial};
 
 /// The work of the first fluid of `sim`.
 fn fluid_work<const D: usize>(sim: &mut Simulation<D>) -> &mut FluidWork<D> {
@@ -412,4 +414,184 @@ fn momentum_crosses_the_fluid_structure_interface_without_loss() {
         let (p, _) = momentum(&sim);
         assert!((p - p0).norm() < 1e-13 * scale, "{substeps:?}: momentum {p0:?} -> {p:?} (scale {scale})");
     }
+}
+
+/// A fluid of `n` x `n` particles at rest from the origin at spacing `dx`, CTVF without
+/// shifting or corrections, of sound speed `c0`, under gravity `g` (downward).
+fn still_fluid(name: &str, n: (usize, usize), dx: f64, c0: f64, g: f64) -> Fluid<2> {
+    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    let mut init = FluidInit::<2>::default();
+    for j in 0..n.1 {
+        for i in 0..n.0 {
+            init.x.push(Vector::<2>::new((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx));
+            init.u.push(Vector::zeros());
+            init.m.push(dx * dx);
+            init.rho.push(1.0);
+            init.p.push(0.0);
+        }
+    }
+    let settings = FluidSettings {
+        pst: Pst::None,
+        corrections: Corrections::NONE,
+        gravity: [0.0, -g, 0.0],
+        ..FluidSettings::internal_flow(1.0, c0, 1.0, dx, kernel.w(dx, dx), 0.01)
+    };
+    Fluid::new(name, dx, init, SchemeName::Ctvf.fluid_scheme(&settings)).unwrap()
+}
+
+/// Two fluid bodies of different physics in one simulation: they meet only if a
+/// multiphase model says how, so the builder refuses them unless kept apart; kept apart,
+/// the vortex steps as it does alone, bit for bit (the second fluid, at rest and of a lower
+/// sound speed, binds neither the time step nor anything else), and the fluid at rest stays
+/// at rest exactly.
+#[test]
+fn two_fluids_of_different_physics_kept_apart_step_as_each_alone() {
+    let alone = vortex_sized(16, SchemeName::Edac, Pst::None, RatePositions::End);
+    let vortex = alone.fluid().clone();
+    let (kernel, domain, time) = (alone.kernel, alone.domain, alone.time_settings);
+    let still = still_fluid("still", (16, 16), 1.0 / 16.0, 5.0, 0.0);
+    let both = || Simulation::builder(domain, kernel).time(time).body(vortex.clone()).body(still.clone());
+    let e = both().build().err().unwrap();
+    assert!(e.contains("bodies `fluid` and `still`") && e.contains("keep them apart"), "{e}");
+    let mut sim = both().without("fluid", "still").build().unwrap();
+    assert_eq!(sim.fluids().count(), 2);
+    let mut alone = alone;
+    for _ in 0..20 {
+        alone.step(f64::INFINITY).unwrap();
+        sim.step(f64::INFINITY).unwrap();
+    }
+    let bits = |f: &Fluid<2>| {
+        let mut b: Vec<u64> = [&f.rho, &f.p].iter().flat_map(|v| f.by_id(v)).map(|x| x.to_bits()).collect();
+        b.extend(f.by_id(&f.x).iter().chain(&f.by_id(&f.u)).flat_map(|x| x.iter().map(|c| c.to_bits())));
+        b
+    };
+    assert_eq!(bits(sim.fluid()), bits(alone.fluid()));
+    assert_eq!(sim.time().to_bits(), alone.time().to_bits());
+    let still = sim.fluids().nth(1).unwrap();
+    assert!(still.u.iter().all(|u| *u == Vector::<2>::zeros()), "the fluid at rest moved");
+}
+
+/// A fluid block in free fall (no walls, no pressure: every particle falls at g) that loses
+/// its particles below a line at every step, and gains a row above it twice, out of its
+/// kernel's reach: the run goes on with the neighbour lists made again each time; every
+/// particle of the block falls at u = -g t (to 1e-12), and every new one, which starts
+/// without rates (its first half kick takes no gravity), at `g dt / 2` less, dt the step
+/// after it came; the count is the count above the line, and the ids stay unique.
+#[test]
+fn a_fluid_that_loses_and_gains_particles_keeps_falling_freely() {
+    let (dx, g) = (0.05, 9.81);
+    let block = still_fluid("block", (20, 10), dx, 20.0, g);
+    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    let domain = Domain::bounded([-1.0, -20.0], [2.0, 2.0]);
+    let mut sim = Simulation::builder(domain, kernel).body(block).build().unwrap();
+    let (mut removed, mut rows) = (0, Vec::new());
+    let mut lag = vec![0.0; 200];
+    for step in 0..400 {
+        let t0 = sim.time();
+        sim.step(f64::INFINITY).unwrap();
+        if rows.last().is_some_and(|(at, _)| *at == step) {
+            let n = rows.len();
+            let dt = sim.time() - t0;
+            rows[n - 1].1 = 0.5 * g * dt;
+        }
+        let above: Vec<bool> = sim.fluid().x.iter().map(|x| x[1] >= 0.0).collect();
+        if above.iter().any(|&k| !k) && above.iter().any(|&k| k) {
+            removed += sim.retain("block", |i| above[i]).unwrap();
+        }
+        if step == 100 || step == 250 {
+            // A row above the block, out of its kernel's reach, falling with it.
+            let f = sim.fluid();
+            let (top, u) = (f.x.iter().map(|x| x[1]).fold(f64::MIN, f64::max), f.u[0]);
+            let mut row = still_fluid("block", (20, 1), dx, 20.0, g);
+            for (x, v) in row.x.iter_mut().zip(&mut row.u) {
+                *x += Vector::<2>::new(0.0, top + 4.0 * dx);
+                *v = u;
+            }
+            assert_eq!(sim.extend("block", row).unwrap(), 20);
+            rows.push((step + 1, 0.0));
+        }
+    }
+    for (k, (_, l)) in rows.iter().enumerate() {
+        lag.extend(std::iter::repeat_n(*l, 20));
+        assert!(*l > 0.0, "row {k}");
+    }
+    let (f, t) = (sim.fluid(), sim.time());
+    assert!(removed > 50, "removed {removed}");
+    assert_eq!(f.len(), 240 - removed);
+    for (u, id) in f.u.iter().zip(&f.id) {
+        let expected = -g * t + lag[*id as usize];
+        assert!(
+            u[0] == 0.0 && (u[1] - expected).abs() < 1e-12 * g * t,
+            "{u:?} against {expected} at t = {t}"
+        );
+    }
+    let mut ids = f.id.clone();
+    ids.sort_unstable();
+    ids.dedup();
+    assert_eq!(ids.len(), f.len(), "ids stay unique");
+    assert!(sim.retain("block", |_| false).unwrap_err().contains("removing all"));
+    assert!(sim.retain("nothing", |_| true).unwrap_err().contains("no body is named `nothing`"));
+}
+
+/// A solid's particles that nothing reaches (farther than the kernel's support from the
+/// rest) leave the rest as they are: a spinning block with one such particle at the end of
+/// its body, which it loses after ten steps and gains back after twenty, steps bit for bit
+/// as the block alone.
+#[test]
+fn a_solid_losing_and_gaining_a_lone_particle_leaves_the_rest_bit_for_bit() {
+    let dx = 0.01;
+    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    let material = SolidMaterial::new(2.0e6, 0.3975, 1000.0).unwrap();
+    let settings = SolidSettings {
+        pst: Pst::None,
+        corrections: true,
+        alpha: 1.0,
+        u_ref: 1.0,
+        w_dx: kernel.w(dx, dx),
+        gravity: [0.0; 3],
+    };
+    let physics = SolidSchemeName::Ctvf.solid_scheme(&settings).unwrap();
+    let block = |lone: bool| {
+        let mut init = SolidInit::<2>::default();
+        for k in 0..64 {
+            let x = Vector::<2>::new(((k % 8) as f64 - 3.5) * dx, ((k / 8) as f64 - 3.5) * dx);
+            init.x.push(x);
+            init.u.push(Vector::<2>::new(-x[1], x[0]) * 50.0);
+            init.m.push(material.rho0 * dx * dx);
+            init.rho.push(material.rho0);
+            init.fixed.push(false);
+        }
+        if lone {
+            init.x.push(Vector::<2>::new(0.5, 0.5));
+            init.u.push(Vector::zeros());
+            init.m.push(material.rho0 * dx * dx);
+            init.rho.push(material.rho0);
+            init.fixed.push(false);
+        }
+        ElasticSolid::new("block", dx, init, material, physics).unwrap()
+    };
+    let domain = Domain::bounded([-1.0, -1.0], [1.0, 1.0]);
+    let build = |lone| Simulation::builder(domain, kernel).body(block(lone)).build().unwrap();
+    let (mut alone, mut sim) = (build(false), build(true));
+    let bits = |sim: &Simulation<2>| {
+        let s = sim.solid("block").unwrap().0;
+        let mut b: Vec<u64> = s.p[..64].iter().map(|x| x.to_bits()).collect();
+        b.extend(s.x[..64].iter().chain(&s.u[..64]).flat_map(|v| v.iter().map(|c| c.to_bits())));
+        b.extend(s.s[..64].iter().flat_map(|m| m.iter().map(|c| c.to_bits())));
+        b
+    };
+    for step in 0..30 {
+        alone.step(f64::INFINITY).unwrap();
+        sim.step(f64::INFINITY).unwrap();
+        if step == 9 {
+            assert_eq!(sim.retain("block", |i| i < 64).unwrap(), 1);
+        }
+        if step == 19 {
+            let mut lone = block(true);
+            lone.retain(&[vec![false; 64], vec![true]].concat()).unwrap();
+            assert_eq!(sim.extend("block", lone).unwrap(), 1);
+        }
+        assert_eq!(bits(&sim), bits(&alone), "step {step}");
+    }
+    assert_eq!(sim.solid("block").unwrap().0.len(), 65);
 }

@@ -1,5 +1,5 @@
 //! Work in stages over tiles, runs of a body's particles in cell order, on the threads of
-//! the pool: the wavefront step's passes ([`wavefront`](super::wavefront)) and IPST's
+//! the pool: the wavefront step's passes ([`wavefront`](crate::solver::schedule::wavefront)) and IPST's
 //! sweeps ([`ipst`](crate::solver::passes::ipst)). A stage of a tile needs the stage before it done on the
 //! tile and on both tiles next to it (cyclically), since a particle's neighbours lie in
 //! those. Each thread owns a region of tiles and takes their stages one at a time as their
