@@ -582,6 +582,19 @@ fn bare(root: &std::path::Path, args: &[&str]) -> Output {
     Command::new(BIN).current_dir(root).args(args).output().unwrap()
 }
 
+/// A fresh clone of the folders `dirs` of `root`: a new folder holding their files.
+fn clone_of(root: &std::path::Path, dirs: &[&str]) -> tempfile::TempDir {
+    let clone = tempfile::tempdir().unwrap();
+    for d in dirs {
+        for (rel, bytes) in files(&root.join(d)) {
+            let p = clone.path().join(d).join(rel);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, bytes).unwrap();
+        }
+    }
+    clone
+}
+
 /// Every file under `dir` with its bytes, by path relative to it.
 fn files(dir: &std::path::Path) -> std::collections::BTreeMap<String, Vec<u8>> {
     fn walk(
@@ -743,14 +756,7 @@ fn the_paper_presets_results_are_committed_and_redrawn_byte_for_byte() {
     let committed_results = files(&root.join("results"));
 
     // A fresh clone: the problems, the committed results and manuscript, no output folder.
-    let clone = tempfile::tempdir().unwrap();
-    for d in ["problems", "results", "manuscript"] {
-        for (rel, bytes) in files(&root.join(d)) {
-            let p = clone.path().join(d).join(rel);
-            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-            std::fs::write(p, bytes).unwrap();
-        }
-    }
+    let clone = clone_of(root, &["problems", "results", "manuscript"]);
     let t = text(&bare(clone.path(), &["status", "--preset", "paper"]));
     assert!(t.contains("2 done, 0 failed, 0 missing"), "{t}");
     // A case of which only the summary is committed is not done: the quick preset runs it.
@@ -834,14 +840,7 @@ fn a_committed_case_holds_what_the_other_presets_figures_read() {
         assert_eq!(snaps, 1, "nx{nx}");
     }
     // A fresh clone: the quick preset runs nothing, and draws its figure.
-    let clone = tempfile::tempdir().unwrap();
-    for d in ["problems", "results"] {
-        for (rel, bytes) in files(&root.join(d)) {
-            let p = clone.path().join(d).join(rel);
-            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
-            std::fs::write(p, bytes).unwrap();
-        }
-    }
+    let clone = clone_of(root, &["problems", "results"]);
     let o = bare(clone.path(), &["reproduce"]);
     let t = text(&o);
     assert!(o.status.success() && t.contains("0 case(s) to run, 1 done"), "{t}");

@@ -60,28 +60,15 @@ macro_rules! forward_counts {
 
 pub(crate) use forward_counts;
 
-/// The counts of [`forward_counts`] and an advance that is `Simulation::advance`'s.
-macro_rules! forward_to_sim {
-    () => {
-        $crate::scenes::stepping::forward_counts!();
-        fn advance(
-            &mut self,
-            t_stop: f64,
-            t_end: f64,
-            on_step: &mut dyn FnMut(f64, u64) -> bool,
-        ) -> Result<bool, $crate::solver::simulation::Divergence> {
-            self.sim.advance(t_stop, t_end, |s| on_step(s.time(), s.steps()))
-        }
-    };
-}
-
-pub(crate) use forward_to_sim;
-
-/// The counts of [`forward_counts`] and an advance that steps one step at a time and calls
-/// `self.after_step()` after each (to follow probes, crossings or extrema at every step),
-/// in the stepping loop of every run ([`step_until`](crate::solver::simulation::step_until)).
+/// The counts of [`forward_counts`] and an advance that steps one step at a time in the
+/// stepping loop of every run ([`step_until`](crate::solver::simulation::step_until)), and calls
+/// `self.after_step()` after each (to follow probes, crossings or extrema at every step), or
+/// the closure given, of the scene (`|_| {}`: nothing).
 macro_rules! forward_stepwise {
     () => {
+        $crate::scenes::stepping::forward_stepwise!(|s: &mut Self| s.after_step());
+    };
+    ($after_step:expr) => {
         $crate::scenes::stepping::forward_counts!();
         fn advance(
             &mut self,
@@ -94,7 +81,7 @@ macro_rules! forward_stepwise {
                 |s| &mut s.sim,
                 (t_stop, t_end),
                 |s| {
-                    s.after_step();
+                    ($after_step)(s);
                     on_step(s.sim.time(), s.sim.steps())
                 },
             )
@@ -102,6 +89,14 @@ macro_rules! forward_stepwise {
     };
 }
 pub(crate) use forward_stepwise;
+
+/// [`forward_stepwise`] with nothing after a step: the scene's `advance` is its simulation's.
+macro_rules! forward_to_sim {
+    () => {
+        $crate::scenes::stepping::forward_stepwise!(|_: &mut Self| {});
+    };
+}
+pub(crate) use forward_to_sim;
 
 /// The [`SceneRun`](super::SceneRun) checkpoint of a scene whose evolving state is its `sim`
 /// and the fields named (each `Serialize` and `Deserialize`): `save_state` writes the

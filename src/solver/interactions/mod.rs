@@ -137,11 +137,13 @@ pub fn interactions(
     };
     if let Some(load) = &pair.load {
         match (dst, same) {
-            (ElasticSolid, true) => {
+            (ElasticSolid | Fluid, true) => {
                 load.check()?;
                 out.push(I::Load);
             }
-            (_, true) => return Err(format!("a load acts on an elastic solid, not on a {dst:?} body")),
+            (Wall, true) => {
+                return Err("a load acts on a body that moves by its forces, not on a wall".into())
+            }
             (_, false) => return Err("a load acts on one body: give it for the body with itself".into()),
         }
     }
@@ -289,7 +291,8 @@ impl<const D: usize> Coupling<D> {
     pub fn add_force(&self, bodies: &[Body<D>], a_ext: &mut [Vector<D>]) {
         if let Coupling::Load(c) = self {
             let fixed = bodies[c.body].as_solid().map(|s| &s.fixed[..]);
-            c.load.add(a_ext, fixed);
+            let ids = bodies[c.body].as_fluid().map(|f| &f.id[..]);
+            c.load.add(a_ext, fixed, ids);
         }
     }
 
@@ -358,7 +361,8 @@ mod tests {
         assert!(interactions(ElasticSolid, ElasticSolid, true, &continuum).is_err());
         let load = PairParams { load: Some(UniformLoad::new([0.0, -1.0, 0.0], 0..3)), ..pair() };
         assert_eq!(interactions(ElasticSolid, ElasticSolid, true, &load).unwrap(), [I::SolidSolid, I::Load]);
-        assert!(interactions(Fluid, Fluid, true, &load).is_err());
+        assert_eq!(interactions(Fluid, Fluid, true, &load).unwrap(), [I::FluidFluid, I::Load]);
+        assert!(interactions(Wall, Wall, true, &load).is_err());
         let off = PairParams { off: true, ..pair() };
         assert!(interactions(Fluid, Wall, false, &off).unwrap().is_empty());
     }

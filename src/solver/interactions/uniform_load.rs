@@ -1,6 +1,7 @@
-//! An applied load: a uniform acceleration on a range of a body's particles, in the order the
-//! scene gave them (solids are never reordered), added into the body's external acceleration
-//! at every evaluation of its accelerations. A surface traction t (N/m^2 in 3D, N/m per unit
+//! An applied load: a uniform acceleration on a range of a body's particles, by their index as
+//! the scene gave them (a solid's order, never changed; a fluid's original ids, as it sorts its
+//! particles by cell), added into the body's external acceleration at every evaluation of its
+//! accelerations. A surface traction t (N/m^2 in 3D, N/m per unit
 //! depth in 2D) on a face is `accel = t dx / (rho0 dx^D)` on the row of particles along it.
 //! Fixed particles in the range get nothing, as they get no gravity: their motion is
 //! prescribed.
@@ -34,9 +35,18 @@ impl UniformLoad {
     }
 
     /// Adds the load into `a_ext` (one entry per particle of the body), except on the
-    /// particles `fixed` marks.
-    pub fn add<const D: usize>(&self, a_ext: &mut [Vector<D>], fixed: Option<&[bool]>) {
+    /// particles `fixed` marks; with `ids`, on the particles whose original id is in the
+    /// range (a fluid's).
+    pub fn add<const D: usize>(&self, a_ext: &mut [Vector<D>], fixed: Option<&[bool]>, ids: Option<&[u32]>) {
         let a = Vector::<D>::from_fn(|k, _| self.accel[k]);
+        if let Some(ids) = ids {
+            for (out, &id) in a_ext.iter_mut().zip(ids) {
+                if self.particles.contains(&(id as usize)) {
+                    *out += a;
+                }
+            }
+            return;
+        }
         let end = self.particles.end.min(a_ext.len());
         for i in self.particles.start.min(end)..end {
             if !fixed.is_some_and(|f| f[i]) {

@@ -595,3 +595,36 @@ fn a_solid_losing_and_gaining_a_lone_particle_leaves_the_rest_bit_for_bit() {
     }
     assert_eq!(sim.solid("block").unwrap().0.len(), 65);
 }
+
+/// A load on a fluid (by its particles' original ids, as the fluid sorts them by cell) is a
+/// body force on them alone: of two blocks of one fluid at rest, 1 m apart, with no pressure
+/// and no gravity, the one loaded moves at `a t` as a whole (to 1e-12) and the other stays
+/// at rest; the fluid's step is then no longer fused into tiles.
+#[test]
+fn a_load_on_a_fluid_accelerates_the_particles_it_names() {
+    let dx = 0.05;
+    let mut fluid = still_fluid("fluid", (10, 20), dx, 20.0, 0.0);
+    for (k, x) in fluid.x.iter_mut().enumerate() {
+        if k >= 100 {
+            // The upper half of the lattice becomes a second block, 1 m to the right.
+            *x += Vector::<2>::new(1.0, -0.5);
+        }
+    }
+    let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
+    let domain = Domain::bounded([-1.0, -1.0], [2.5, 2.5]);
+    let load = crate::solver::interactions::UniformLoad::new([0.5, 0.25, 0.0], 0..100);
+    let mut sim = Simulation::builder(domain, kernel).body(fluid).load("fluid", load).build().unwrap();
+    for _ in 0..20 {
+        sim.step(f64::INFINITY).unwrap();
+    }
+    let (f, t) = (sim.fluid(), sim.time());
+    assert_eq!(sim.wavefront_steps(), 0);
+    for (u, id) in f.u.iter().zip(&f.id) {
+        if *id < 100 {
+            let a = Vector::<2>::new(0.5, 0.25) * t;
+            assert!((u - a).norm() < 1e-12 * a.norm(), "loaded {id}: {u:?} against {a:?}");
+        } else {
+            assert_eq!(*u, Vector::<2>::zeros(), "unloaded {id}");
+        }
+    }
+}

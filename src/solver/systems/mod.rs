@@ -361,6 +361,7 @@ impl<const D: usize> Rates<D> {
                 retain_by(&mut r.dp, keep);
                 retain_by(&mut r.drho, keep);
                 retain_by(&mut r.a_c, keep);
+                retain_by(&mut r.a_ext, keep);
             }
             Rates::Solid(r) => {
                 retain_by(&mut r.du, keep);
@@ -399,6 +400,7 @@ impl<const D: usize> Rates<D> {
     pub fn external_mut(&mut self) -> Option<&mut [Vector<D>]> {
         match self {
             Rates::Solid(r) if !r.a_ext.is_empty() => Some(&mut r.a_ext),
+            Rates::Fluid(r) if !r.a_ext.is_empty() => Some(&mut r.a_ext),
             _ => None,
         }
     }

@@ -97,6 +97,10 @@ pub struct FluidRates<const D: usize> {
     /// own length.
     #[serde(default)]
     pub a_c_dt: Option<f64>,
+    /// The external acceleration the couplings added at the last evaluation (a load),
+    /// included in `du`; empty for a fluid none acts on.
+    #[serde(skip)]
+    pub a_ext: Vec<Vector<D>>,
 }
 
 impl<const D: usize> FluidRates<D> {
@@ -119,6 +123,7 @@ impl<const D: usize> FluidRates<D> {
             drho: if density { vec![0.0; n] } else { Vec::new() },
             a_c: if transport { vec![Vector::zeros(); n] } else { Vec::new() },
             a_c_dt: None,
+            a_ext: Vec::new(),
         }
     }
 }
@@ -160,35 +165,10 @@ impl<const D: usize> Fluid<D> {
 
     /// Adds the particles of `other`, a fluid body of the same physics and smoothing length,
     /// as a part of this one: its particles come after this one's, in their order, with
-    /// their original indices offset by this one's count. Both must be as built (not yet
-    /// reordered by a simulation).
+    /// their original indices offset by this one's count (both as built, their ids those of
+    /// their order): [`extend`](Self::extend) on a body as built.
     pub fn merge(&mut self, other: Fluid<D>) -> Result<(), String> {
-        let (a, b) = (&self.parts[0].name, &other.parts[0].name);
-        if !other.physics.same_physics(&self.physics) || other.h != self.h {
-            return Err(format!(
-                "fluid `{b}` differs from fluid `{a}` in its physics or smoothing length: fluids of different physics in one simulation are not supported"
-            ));
-        }
-        let offset = self.len() as u32;
-        if self.len() + other.len() > u32::MAX as usize {
-            return Err(format!("fluids `{a}` and `{b}`: more particles than a body indexes"));
-        }
-        self.parts.extend(
-            other
-                .parts
-                .into_iter()
-                .map(|p| FluidPart { name: p.name, ids: p.ids.start + offset..p.ids.end + offset }),
-        );
-        self.x.extend(other.x);
-        self.u.extend(other.u);
-        if let (Some(mine), Some(theirs)) = (self.u_hat.as_mut(), other.u_hat) {
-            mine.extend(theirs);
-        }
-        self.m.extend(other.m);
-        self.rho.extend(other.rho);
-        self.p.extend(other.p);
-        self.id.extend(other.id.into_iter().map(|i| i + offset));
-        Ok(())
+        self.extend(other)
     }
 
     /// The name of the part particle `id` (an original index) belongs to.

@@ -35,6 +35,8 @@ pub struct FluidWork<const D: usize> {
     boundaries: Vec<usize>,
     /// IPST's moves in the last step.
     pub ipst_iterations: usize,
+    /// Whether a coupling adds an external acceleration to it (a load).
+    external: bool,
     /// The tiles of the wavefront step, the schedule asked for and its tuner per thread
     /// count, how the last step ran, whether the tuner times this step, and the steps that
     /// ran as a wavefront.
@@ -100,6 +102,7 @@ impl<const D: usize> BodyStages<D> for FluidStages {
             own,
             boundaries: of(Interaction::FluidBoundary).collect(),
             ipst_iterations: 0,
+            external: incoming.iter().any(|&k| couplings[k].interaction() == Interaction::Load),
             wave: Wavefront::new(),
             schedule: Schedule::default(),
             tuners: Vec::new(),
@@ -225,7 +228,21 @@ impl<const D: usize> BodyStages<D> for FluidStages {
             rates,
             dt_nominal,
         );
+        // The external acceleration the couplings added (a load).
+        let FluidRates { du, a_ext, .. } = rates;
+        du.iter_mut().zip(a_ext.iter()).for_each(|(du, a)| *du += a);
         lap(clock, &mut times.accelerations);
+    }
+
+    /// The external acceleration reset to zero before the couplings add theirs.
+    fn reset_external(&self, w: &mut World<D>, i: usize) {
+        if !w.work[i].as_fluid().expect("a fluid's work").external {
+            return;
+        }
+        let n = w.bodies[i].len();
+        let Rates::Fluid(r) = &mut w.rates[i] else { unreachable!("a fluid's rates") };
+        r.a_ext.clear();
+        r.a_ext.resize(n, crate::solver::math::Vector::zeros());
     }
 
     /// IPST's pass (eqs. 37-41), if the fluid shifts with it, after pass B.
@@ -263,7 +280,8 @@ impl<const D: usize> BodyStages<D> for FluidStages {
     /// its scheme [allows](wavefront_applies) it, and the body makes enough tiles.
     fn fused(&self, w: &mut World<D>, i: usize, dt: f64, dt_nominal: f64) -> bool {
         let World { bodies, rates, work, couplings, bins, kernel, settings, times, .. } = w;
-        let alone = bodies.len() == 1;
+        // Alone in its scene, with no coupling besides its own (a load is added after pass B).
+        let alone = bodies.len() == 1 && !work[i].as_fluid().expect("a fluid's work").external;
         let fluid = bodies[i].as_fluid().expect("a fluid");
         let allowed =
             settings.rate_positions == RatePositions::End && wavefront_applies(&fluid.physics, alone);
