@@ -302,11 +302,32 @@ enum Command {
         #[command(flatten)]
         dirs: DirArgs,
     },
-    /// Compare every bound of the problem files with the cached results (for CI).
+    /// Compare the bounds of the problem files with the cached results, or (--baseline) the
+    /// quick preset's results with the committed baselines, metric by metric (for CI).
     Check {
+        /// Problem names (file stems under --problems); every problem without.
+        problem: Vec<String>,
         /// Preset.
         #[arg(long, default_value = "quick")]
         preset: String,
+        /// Only cases whose name (or problem/name) matches this glob.
+        #[arg(long = "match", value_name = "GLOB")]
+        matching: Option<String>,
+        /// Compare with the committed baselines (baselines/PROBLEM.json) instead of the bounds:
+        /// every metric as it was (exactly, or within the tolerance the problem file states).
+        #[arg(long)]
+        baseline: bool,
+        #[command(flatten)]
+        dirs: DirArgs,
+    },
+    /// Rewrite the baselines of the named problems from the quick preset's results after a
+    /// deliberate change, printing what moved (the only writer of baselines).
+    Bless {
+        /// Problem names (file stems under --problems).
+        problem: Vec<String>,
+        /// Every problem.
+        #[arg(long)]
+        all: bool,
         #[command(flatten)]
         dirs: DirArgs,
     },
@@ -487,7 +508,10 @@ fn run(cli: Cli) -> u8 {
         },
         Command::SlurmTask { manifest, index } => slurm::task::run(&manifest, index),
         Command::Status { preset, stale, dirs } => commands::status(&dirs.dirs(&preset), &preset, stale),
-        Command::Check { preset, dirs } => commands::check(&dirs.dirs(&preset), &preset),
+        Command::Check { problem, preset, matching, baseline, dirs } => {
+            commands::check(&dirs.dirs(&preset), &preset, &problem, matching.as_deref(), baseline)
+        }
+        Command::Bless { problem, all, dirs } => commands::bless(&dirs.dirs("quick"), &problem, all),
         Command::Simulate {
             scene,
             sets,

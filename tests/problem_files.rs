@@ -237,3 +237,38 @@ fn every_committed_case_holds_what_its_figures_read() {
     bad.dedup();
     assert!(bad.is_empty(), "{} committed case(s) lack what figures read:\n{}", bad.len(), bad.join("\n"));
 }
+
+/// Every problem has a committed baseline of its quick preset whose cases are the preset's,
+/// with the same inputs: a new case, a changed parameter or a new solver version is blessed
+/// (`sphrepro bless PROBLEM`) in the change that makes it. Static: no simulation.
+#[test]
+fn every_problem_has_a_baseline_of_its_current_cases() {
+    use sphrepro::automation::{baseline, cache::CaseRecord};
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut paths: Vec<_> = std::fs::read_dir(root.join("problems"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .collect();
+    paths.sort();
+    let mut bad = Vec::new();
+    for path in &paths {
+        let p = registry::parse(path, &std::fs::read_to_string(path).unwrap(), baseline::PRESET).unwrap();
+        let Some(b) = baseline::read(&p).unwrap() else {
+            bad.push(format!("{}: no baseline ({})", p.name, baseline::path(&p).display()));
+            continue;
+        };
+        let now: Vec<(String, String)> =
+            p.cases.iter().map(|c| (c.name.clone(), CaseRecord::new(&p.name, c).key)).collect();
+        let then: Vec<(String, String)> = b.cases.iter().map(|(n, o)| (n.clone(), o.key.clone())).collect();
+        let mut now_sorted = now.clone();
+        now_sorted.sort();
+        if now_sorted != then {
+            bad.push(format!(
+                "{}: the baseline's cases or their inputs differ from the quick preset's",
+                p.name
+            ));
+        }
+    }
+    assert!(bad.is_empty(), "{}", bad.join("\n"));
+}

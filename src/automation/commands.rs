@@ -3,7 +3,7 @@
 
 use super::registry::{self, Problem};
 use super::runner::{self, Options};
-use super::{cache, check, results, slurm, study};
+use super::{baseline, cache, check, results, slurm, study};
 use crate::{errln, outln};
 use std::path::{Path, PathBuf};
 
@@ -436,14 +436,48 @@ pub fn status(dirs: &Dirs, preset: &str, list_stale: bool) -> u8 {
 }
 
 /// `check`: every bound of the preset against the cached results.
-pub fn check(dirs: &Dirs, preset: &str) -> u8 {
-    let ps = match load(dirs, preset, &[]) {
+pub fn check(
+    dirs: &Dirs,
+    preset: &str,
+    only: &[String],
+    matching: Option<&str>,
+    against_baseline: bool,
+) -> u8 {
+    if against_baseline && preset != baseline::PRESET {
+        errln!(
+            "error: `--baseline` compares the `{}` preset's results; `--preset {preset}` has no baseline",
+            baseline::PRESET
+        );
+        return BAD_INPUT;
+    }
+    let mut ps = match load(dirs, preset, only) {
         Ok(p) => p,
         Err(e) => {
             errln!("error: {e}");
             return BAD_INPUT;
         }
     };
+    if let Some(g) = matching {
+        let m = match globset::Glob::new(g) {
+            Ok(m) => m.compile_matcher(),
+            Err(e) => {
+                errln!("error: --match `{g}`: {e}");
+                return BAD_INPUT;
+            }
+        };
+        for p in &mut ps {
+            let name = p.name.clone();
+            p.cases.retain(|c| m.is_match(&c.name) || m.is_match(format!("{name}/{}", c.name)));
+        }
+        ps.retain(|p| !p.cases.is_empty());
+        if ps.is_empty() {
+            errln!("error: --match `{g}` selects no case");
+            return BAD_INPUT;
+        }
+    }
+    if against_baseline {
+        return check_baselines(dirs, &ps, matching.is_some());
+    }
     let (ok, bad) = check::check(&dirs.output, &ps);
     for b in &bad {
         outln!("FAIL {}: {}", b.case, b.what);
@@ -454,6 +488,98 @@ pub fn check(dirs: &Dirs, preset: &str) -> u8 {
     } else {
         FAILED
     }
+}
+
+/// `check --baseline`: every problem's results against its committed baseline, metric by
+/// metric, within the tolerances its file states (exact by default); a case `--match` left
+/// out (`partial`) is not a change.
+fn check_baselines(dirs: &Dirs, ps: &[Problem], partial: bool) -> u8 {
+    let (mut status, mut compared) = (OK, 0);
+    for p in ps {
+        let old = match baseline::read(p) {
+            Ok(Some(b)) => b,
+            Ok(None) => {
+                outln!(
+                    "FAIL {}: no baseline ({}); `sphrepro bless {}` writes it",
+                    p.name,
+                    baseline::path(p).display(),
+                    p.name
+                );
+                status = FAILED;
+                continue;
+            }
+            Err(e) => {
+                errln!("error: {e}");
+                status = FAILED;
+                continue;
+            }
+        };
+        let (now, missing) = baseline::current(&dirs.output, p);
+        for m in &missing {
+            outln!("FAIL {}/{m}: no result to compare (`sphrepro run {}` computes it)", p.name, p.name);
+            status = FAILED;
+        }
+        let mut changes = baseline::compare(&old, &now, &p.baseline);
+        // Cases not selected or not run are named above, not as changes.
+        changes.retain(|c| {
+            !(c.what == "case"
+                && c.old == "in the baseline"
+                && (partial || missing.iter().any(|m| m.starts_with(&format!("{}:", c.case)))))
+        });
+        compared += now.cases.len();
+        if !changes.is_empty() {
+            status = FAILED;
+            for c in &changes {
+                let rel = c.rel.map(|r| format!(" ({r:+.3e})")).unwrap_or_default();
+                outln!("FAIL {}/{}: {}: {} -> {}{rel}", p.name, c.case, c.what, c.old, c.new);
+            }
+            if let Some(reason) = &p.baseline.reason {
+                outln!("  ({}'s tolerances: {reason})", p.name);
+            }
+        }
+    }
+    outln!(
+        "{compared} case(s) compared with their baselines: {}",
+        if status == OK {
+            "no change"
+        } else {
+            "changed or missing (a deliberate change is blessed with `sphrepro bless PROBLEM`)"
+        }
+    );
+    status
+}
+
+/// `bless`: rewrites the baselines of `only` (every problem with `all`) from the quick
+/// preset's results, and prints what moved.
+pub fn bless(dirs: &Dirs, only: &[String], all: bool) -> u8 {
+    if only.is_empty() && !all {
+        errln!("error: name the problems whose baselines to rewrite, or give `--all`");
+        return BAD_INPUT;
+    }
+    let ps = match load(dirs, baseline::PRESET, only) {
+        Ok(p) => p,
+        Err(e) => {
+            errln!("error: {e}");
+            return BAD_INPUT;
+        }
+    };
+    let mut status = OK;
+    for p in &ps {
+        match baseline::bless(&dirs.output, p) {
+            Ok(changes) if changes.is_empty() => {
+                outln!("{}: unchanged ({})", p.name, baseline::path(p).display())
+            }
+            Ok(changes) => {
+                outln!("{}: {} change(s), written to {}", p.name, changes.len(), baseline::path(p).display());
+                outln!("{}", baseline::table(&p.name, &changes));
+            }
+            Err(e) => {
+                errln!("error: {e}");
+                status = FAILED;
+            }
+        }
+    }
+    status
 }
 
 /// The cache folder of every case (for tests and tools).

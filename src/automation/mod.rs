@@ -9,7 +9,8 @@
 //!   result must hold to be done;
 //! - [`runner`]: a job pool of `simulate` subprocesses;
 //! - [`slurm`]: the same cases as job arrays on a Slurm cluster;
-//! - [`check`]: bounds for CI and case states;
+//! - [`check`]: bounds for CI and case states; [`baseline`]: the quick preset's results
+//!   committed as regression baselines, compared metric by metric, rewritten by `bless`;
 //! - [`study`]: the figures and tables a problem declares, the speed-accuracy trade and
 //!   stability maps, the verdicts on the paper's claims, and the manuscript;
 //! - [`report`]: figures, tables and the manuscript built from run results;
@@ -18,6 +19,7 @@
 //! It uses the scenes' declared parameters and the `summary.json` / `timeseries.csv` /
 //! `.vtu` formats, nothing else from `solver`.
 
+pub mod baseline;
 pub mod cache;
 pub mod check;
 pub mod commands;

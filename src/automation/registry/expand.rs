@@ -3,7 +3,7 @@
 //! group's grid expanded into one case per combination (like automan's `mdict`/`dprod`),
 //! named from the group's template, and the same simulation under two names run once.
 
-use super::model::{valid_name, Case, Claim, Problem, MAX_CASES};
+use super::model::{valid_name, BaselineRule, Case, Claim, Problem, MAX_CASES};
 use super::schema::{Loc, ProblemFile, RawParams, Span};
 use crate::scenes::params::{Params, Spec, Value};
 use crate::scenes::{self, SceneEntry};
@@ -136,6 +136,55 @@ impl Expand<'_> {
             tables,
             bounds,
             claims,
+            baseline: self.baseline()?,
+        })
+    }
+
+    /// The `[baseline]` rule: tolerances finite and not negative, of metrics the scene
+    /// reports, with a reason whenever one is given.
+    fn baseline(&self) -> Result<BaselineRule, String> {
+        let Some(b) = &self.file.baseline else { return Ok(BaselineRule::default()) };
+        let (span, raw) = (b.span(), b.get_ref());
+        let bad = |t: f64| !(t.is_finite() && t >= 0.0);
+        if let Some(t) = raw.tolerance.filter(|&t| bad(t)) {
+            return Err(self.loc.err(
+                span,
+                "baseline.tolerance",
+                format!("{t}: a relative tolerance is finite and not negative"),
+            ));
+        }
+        for (m, &t) in &raw.tolerances {
+            if !self.scene.metrics.contains(&m.as_str()) {
+                return Err(self.loc.err(
+                    span,
+                    "baseline.tolerances",
+                    format!(
+                        "scene `{}` has no metric `{m}`; its metrics: {}",
+                        self.scene.name,
+                        self.scene.metrics.join(", ")
+                    ),
+                ));
+            }
+            if bad(t) {
+                return Err(self.loc.err(
+                    span,
+                    "baseline.tolerances",
+                    format!("`{m}` = {t}: a relative tolerance is finite and not negative"),
+                ));
+            }
+        }
+        let loose = raw.tolerance.is_some_and(|t| t > 0.0) || raw.tolerances.values().any(|&t| t > 0.0);
+        if loose && raw.reason.as_deref().is_none_or(|r| r.trim().is_empty()) {
+            return Err(self.loc.err(
+                span,
+                "baseline.reason",
+                "a tolerance needs its reason: why the results are not exact",
+            ));
+        }
+        Ok(BaselineRule {
+            tolerance: raw.tolerance.unwrap_or(0.0),
+            tolerances: raw.tolerances.clone(),
+            reason: raw.reason.clone(),
         })
     }
 

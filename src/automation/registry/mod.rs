@@ -20,8 +20,8 @@ mod schema;
 
 pub use load::{load, load_dir, parse};
 pub use model::{
-    glob_matches, Bound, Case, Claim, ClaimTest, Figure, FigureKind, ItemInfo, Problem, Reference, Select,
-    Table, Test, DEFAULT_PRESET,
+    glob_matches, BaselineRule, Bound, Case, Claim, ClaimTest, Figure, FigureKind, ItemInfo, Problem,
+    Reference, Select, Table, Test, DEFAULT_PRESET,
 };
 pub use reference::reference_dir;
 

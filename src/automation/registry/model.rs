@@ -329,6 +329,29 @@ pub struct Problem {
     pub bounds: Vec<Bound>,
     /// The paper's claims, each resolved in every preset.
     pub claims: Vec<Claim>,
+    /// How far `check --baseline` lets the quick preset's metrics move.
+    pub baseline: BaselineRule,
+}
+
+/// How far `check --baseline` lets a metric of the quick preset move from its committed
+/// baseline: exactly not at all unless the problem file says otherwise (`[baseline]`), with
+/// the reason. The arithmetic is deterministic on any number of threads, so a result that
+/// moves has changed.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BaselineRule {
+    /// The relative tolerance of every metric not named below (0: exact).
+    pub tolerance: f64,
+    /// Relative tolerances per metric.
+    pub tolerances: BTreeMap<String, f64>,
+    /// Why the results are not exact, where a tolerance is given.
+    pub reason: Option<String>,
+}
+
+impl BaselineRule {
+    /// The relative tolerance of `metric`.
+    pub fn of(&self, metric: &str) -> f64 {
+        self.tolerances.get(metric).copied().unwrap_or(self.tolerance)
+    }
 }
 
 impl Problem {

@@ -36,6 +36,21 @@ pub(super) struct ProblemFile {
     pub(super) bounds: Vec<Spanned<BoundFile>>,
     #[serde(default)]
     pub(super) claims: Vec<Spanned<ClaimFile>>,
+    #[serde(default)]
+    pub(super) baseline: Option<Spanned<BaselineFile>>,
+}
+
+/// The `[baseline]` table: how far `check --baseline` lets a metric move from the committed
+/// baseline (relative; exact when absent), for every metric or per metric, and why.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct BaselineFile {
+    #[serde(default)]
+    pub(super) tolerance: Option<f64>,
+    #[serde(default)]
+    pub(super) tolerances: BTreeMap<String, f64>,
+    #[serde(default)]
+    pub(super) reason: Option<String>,
 }
 
 /// A `[[cases]]` group: fixed parameters, a grid of lists expanded into one case per

@@ -118,6 +118,18 @@ pub fn jaumann_rate<const D: usize>(s: &Matrix<D>, grad_u: &Matrix<D>, shear_mod
     deviator * (2.0 * shear_modulus) + s * omega.transpose() + omega * s
 }
 
+/// A factor on the pair term of eq. (30), [`momentum`]: 1, unless the environment variable
+/// `SPHREPRO_PERTURB_SOLID_MOMENTUM` gives another (read once per process). It exists for the
+/// test of the regression guard, `check --baseline`: a change to one term's arithmetic must
+/// fail the baselines of the problems that use it and no others. (A factor of 1 changes no
+/// bit.)
+pub fn momentum_factor() -> f64 {
+    static FACTOR: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *FACTOR.get_or_init(|| {
+        std::env::var("SPHREPRO_PERTURB_SOLID_MOMENTUM").ok().and_then(|v| v.parse().ok()).unwrap_or(1.0)
+    })
+}
+
 /// Eq. (30) without its artificial viscosity: `-m_b [(p_a/rho_a^2 + p_b/rho_b^2) I
 /// - (sigma'_a/rho_a^2 + sigma'_b/rho_b^2)] grad W`. Monaghan's `Pi_ab` is grouped with
 /// the pressure (`-m_b Pi_ab grad W`,

@@ -110,6 +110,8 @@ pub struct AccelSums<const D: usize> {
 /// The terms of the accelerations a scheme evaluates.
 #[derive(Clone, Copy, Debug)]
 pub struct AccelTerms {
+    /// The factor on the pair term of eq. (30): 1 ([`momentum_factor`](solid::momentum_factor)).
+    pub momentum: f64,
     /// Artificial viscosity `(alpha, c0)`, eq. (28).
     pub viscosity: Option<(f64, f64)>,
     /// Sun's shifting `(W(dx), R, n)`, eq. (36).
@@ -128,7 +130,7 @@ impl AccelTerms {
         b: &SolidPoint<D>,
         ab: &Pair<D>,
     ) {
-        s.acc += solid::momentum(a, b, ab);
+        s.acc += solid::momentum(a, b, ab) * self.momentum;
         if let Some((alpha, c)) = self.viscosity {
             s.acc += monaghan_values(a.u - b.u, (a.rho, b.rho), b.m, ab, alpha, c);
         }

@@ -122,6 +122,7 @@ pub fn accelerations<const D: usize>(
     let s = &solid.physics;
     let (pts, x, h) = (&passes.points, &solid.x, solid.h);
     let terms = AccelTerms {
+        momentum: crate::solver::equations::solid::momentum_factor(),
         viscosity: s.artificial_viscosity.map(|alpha| (alpha, solid.material.c0())),
         sun: s.shifting.map(|sh| (sh.w_dx, sh.r, sh.n)),
         artificial_stress: s.artificial_stress.map(|a| (a.w_dx, a.n)),
