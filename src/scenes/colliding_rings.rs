@@ -11,7 +11,9 @@
 //! (after Monaghan 2000) give each ring 0.059 c0, so that the rings approach at 0.118 c0
 //! (about 0.12 c0); the CTVF authors' PySPH script sets the left ring to 0.059 c0 and the
 //! right one to -0.059 c0. `v0_over_c0` is that closing speed over c0 (eq. 8's c0 of the
-//! material), whatever nu.
+//! material), whatever nu. Sun's shifting (eq. 36) takes `Ma c0` = v0 unless `shift_speed`
+//! sets it: the authors' script sets 50 m/s ("manually taken by running one simulation"),
+//! with h = 1.3 dx.
 //!
 //! **Geometry.** Each ring is made of particles on concentric circles (a ring lattice) of
 //! radii r_k = r_min + (k + 1/2) dx, k = 0 .. round((r_max - r_min) / dx) - 1, with
@@ -42,7 +44,10 @@
 //!   both rings at every time-series row and at the end: the largest number of
 //!   clusters (particles closer than 1.5 dx connected) and the largest nearest-neighbour
 //!   distance, in dx. Two whole rings apart are 2 clusters; rings in contact are 1; more
-//!   than 2 is fracture.
+//!   than 2 is fracture. In a run that blows up, over what it ran.
+//! - `clusters_final`: the clusters at the end: 2 when the rings have parted whole.
+//! - `fracture_time` (s): the first time-series row with more than 2 clusters (absent if
+//!   none); kept by a run that blows up after it.
 //! - `rebound_speed_ratio`: `-U(tf) / U(0)`, with U the x velocity of the left ring's
 //!   centre of mass (`sum m u_x / sum m` over its particles; U(0) = v0 / 2). 1: the ring
 //!   leaves at the speed it came with (elastic rebound); 0: it stopped; -1: it has not
@@ -91,9 +96,16 @@ pub const ENTRY: SceneEntry = SceneEntry {
     params,
     build,
     check: |p| setup(p).map(drop),
-    metrics: &["clusters_max", "max_gap", "rebound_speed_ratio", "energy_rel_error"],
+    metrics: &[
+        "clusters_max",
+        "max_gap",
+        "clusters_final",
+        "fracture_time",
+        "rebound_speed_ratio",
+        "energy_rel_error",
+    ],
     columns: &["t", "ax", "ay", "bx", "by", "u_left", "energy", "clusters", "max_gap"],
-    outputs: 0,
+    outputs: 1,
 };
 
 fn params() -> Vec<Spec> {
@@ -112,6 +124,13 @@ fn params() -> Vec<Spec> {
             Bound::Positive,
             "distance between the rings' centres (m); more than 2 r_max",
         ),
+        Spec::float(
+            "shift_speed",
+            0.0,
+            Bound::NonNegative,
+            "the reference speed Ma c0 of Sun's shifting, eq. (36), in m/s; 0: the closing speed v0 (the authors' code sets 50 m/s)",
+        )
+        .added_later(),
         Spec::choice(
             "rings",
             &["one_body", "two_bodies"],
@@ -160,7 +179,18 @@ fn setup(p: &Params) -> Result<Setup, String> {
         .map(|m| m.c0())
         .unwrap_or(0.0);
     let v0 = p.float("v0_over_c0") * c0;
-    let solid = solid_setup(scene, p, (v0, "`v0_over_c0`"), v0, [0.0; 3])?;
+    // Sun's shifting's speed: the closing speed, or the one given.
+    let shift = match p.float("shift_speed") {
+        s if s > 0.0 && p.str("pst") != "sun" => {
+            return Err(format!(
+                "scene `{scene}`: parameter `shift_speed` = {s:?}: only Sun's shifting (`pst` = sun) reads it, not `pst` = {}",
+                p.str("pst")
+            ))
+        }
+        s if s > 0.0 => s,
+        _ => v0,
+    };
+    let solid = solid_setup(scene, p, (v0, "`v0_over_c0`"), shift, [0.0; 3])?;
     let dx = solid.dx;
     if sep <= 2.0 * ro {
         return Err(format!(
@@ -339,8 +369,9 @@ impl Rings {
     }
 
     fn fracture(&mut self) -> fracture::Fracture {
-        let x = self.positions();
-        self.fracture.observe(&x, self.dx, LINK)
+        let (t, x) = (self.sim.time(), self.positions());
+        // Two rings apart are two clusters; more is fracture.
+        self.fracture.observe_at(t, &x, (self.dx, LINK), 2)
     }
 }
 
@@ -397,12 +428,17 @@ impl SceneRun for Rings {
     fn metrics(&self) -> BTreeMap<String, f64> {
         // The detector at the end too, whatever the sampling.
         let worst = self.fracture.with(&self.positions(), self.dx, LINK);
-        let mut m = BTreeMap::from(worst.metrics());
+        let mut m: BTreeMap<String, f64> = worst.metrics().into_iter().collect();
+        let now = fracture::detect(&self.positions(), self.dx, LINK);
         m.extend([
+            ("clusters_final".to_string(), now.clusters as f64),
             ("rebound_speed_ratio".to_string(), -self.u_left() / self.u0),
             ("energy_rel_error".to_string(), self.energy_err),
         ]);
         m
+    }
+    fn running_metrics(&self) -> BTreeMap<String, f64> {
+        self.fracture.metrics().into_iter().collect()
     }
     checkpoint!(energy_err, fracture);
 }
@@ -501,6 +537,15 @@ mod tests {
             p.set_str("colliding_rings", &specs, key, value).unwrap();
             let e = setup(&p).err().unwrap();
             assert!(e.contains(&format!("`{key}` = {value}")), "{e}");
+        }
+        // Sun's shifting's speed given to a run that does not shift by Sun's method.
+        for pst in ["ipst", "none"] {
+            let mut p = Params::defaults(&specs);
+            for (key, value) in [("pst", pst), ("shift_speed", "50")] {
+                p.set_str("colliding_rings", &specs, key, value).unwrap();
+            }
+            let e = setup(&p).err().unwrap();
+            assert!(e.contains("`shift_speed` = 50.0") && e.contains(pst), "{e}");
         }
     }
 }

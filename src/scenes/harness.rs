@@ -346,7 +346,7 @@ pub fn run(entry: &SceneEntry, params: &Params, out: &Path, opts: &RunOptions) -
     progress.finish();
     let (status, reason, metrics) = match &outcome {
         Outcome::Completed(m) => (Status::Completed, None, m.clone()),
-        Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), BTreeMap::new()),
+        Outcome::Diverged(d) => (Status::Diverged, Some(d.reason.clone()), scene.running_metrics()),
         Outcome::Failed(r) => (Status::Failed, Some(r.clone()), BTreeMap::new()),
     };
     let mut s = summary(entry, params, scene.as_ref(), status, reason, metrics, started, t0, stepping);

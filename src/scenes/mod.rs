@@ -68,6 +68,11 @@ pub trait SceneRun {
     fn snapshot(&self, dir: &Path, index: usize) -> std::io::Result<Vec<(String, String)>>;
     /// The metrics of `summary.json` at the end of a completed run.
     fn metrics(&self) -> BTreeMap<String, f64>;
+    /// The metrics a run defines before its end (running records: the worst fracture seen
+    /// and when it began), which the summary of a run that blew up keeps.
+    fn running_metrics(&self) -> BTreeMap<String, f64> {
+        BTreeMap::new()
+    }
     /// Everything that evolves (bodies, rates, time, the scene's running extrema), for a
     /// checkpoint from which the run resumes bit for bit.
     fn save_state(&self) -> serde_json::Value;

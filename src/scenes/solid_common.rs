@@ -8,7 +8,7 @@
 use super::params::{Bound, Params, Spec};
 use crate::solver::kernel::{Kernel, KernelKind};
 use crate::solver::math::Vector;
-use crate::solver::scheme::{Pst, SolidScheme, SolidSchemeName, SolidSettings};
+use crate::solver::scheme::{Pst, SolidGradient, SolidScheme, SolidSchemeName, SolidSettings, SurfaceShift};
 use crate::solver::systems::{ElasticSolid, SolidMaterial};
 use serde::{Deserialize, Serialize};
 
@@ -52,6 +52,12 @@ pub struct SolidKeys {
     pub pst: &'static str,
     /// The correction terms.
     pub corrections: &'static str,
+    /// The kernel gradient: the paper's or corrected.
+    pub gradient: &'static str,
+    /// GTVF's background-pressure cap.
+    pub gtvf_p_ref: &'static str,
+    /// How the shift is kept from the free surface.
+    pub surface_shift: &'static str,
 }
 
 /// A solid scene's parameter names.
@@ -62,6 +68,9 @@ pub const SOLID: SolidKeys = SolidKeys {
     scheme: "scheme",
     pst: "pst",
     corrections: "corrections",
+    gradient: "gradient",
+    gtvf_p_ref: "gtvf_p_ref",
+    surface_shift: "surface_shift",
 };
 
 /// The parameter names of a structure in a fluid: prefixed `solid_` where the fluid's
@@ -73,6 +82,9 @@ pub const STRUCTURE: SolidKeys = SolidKeys {
     scheme: "solid_scheme",
     pst: "solid_pst",
     corrections: "solid_corrections",
+    gradient: "solid_gradient",
+    gtvf_p_ref: "solid_gtvf_p_ref",
+    surface_shift: "solid_surface_shift",
 };
 
 /// The shifting choices of a solid.
@@ -113,13 +125,13 @@ pub fn solid_params_as(d: &SolidDefaults, k: &SolidKeys) -> Vec<Spec> {
             k.scheme,
             SolidSchemeName::NAMES,
             "ctvf",
-            "solid scheme: ctvf (eq. 31 of u, corrections), gtvf (of u~, none) or gray (no transport velocity, Monaghan's artificial stress)",
+            "solid scheme: ctvf (eq. 31 of u, corrections), gtvf_pst (of u~, no corrections, shifted by pst), gtvf (the same homogenised by GTVF's background pressure; pst = none) or gray (no transport velocity, Monaghan's artificial stress; pst = none)",
         ),
         Spec::choice(
             k.pst,
             SOLID_PST,
             d.pst,
-            "particle shifting: Sun 2019 (eq. 36), IPST (sec. 3.3) or none (gray: none)",
+            "particle shifting: Sun 2019 (eq. 36), IPST (sec. 3.3) or none (gray and gtvf: none)",
         ),
         Spec::choice(
             k.corrections,
@@ -127,6 +139,27 @@ pub fn solid_params_as(d: &SolidDefaults, k: &SolidKeys) -> Vec<Spec> {
             "all",
             "the CTVF correction terms of eqs. (25) and (32) (ctvf)",
         ),
+        Spec::choice(
+            k.gradient,
+            SolidGradient::NAMES,
+            "paper",
+            "the solid's kernel gradient: the paper's, or corrected by L = (sum V_b grad W (x) x_ba)^-1 (Bonet & Lok; beyond the paper)",
+        )
+        .added_later(),
+        Spec::float(
+            k.gtvf_p_ref,
+            0.0,
+            Bound::NonNegative,
+            "cap p_ref of GTVF's background pressure p0 = min(10 |p|, p_ref) (Pa; gtvf only); 0: the bulk modulus, as the authors' code",
+        )
+        .added_later(),
+        Spec::choice(
+            k.surface_shift,
+            SurfaceShift::NAMES,
+            "normal",
+            "near the free surface the shift loses its normal component (normal, eq. 44 as printed) or only an outward one (outward, the authors' code)",
+        )
+        .added_later(),
     ]);
     v
 }
@@ -213,6 +246,14 @@ pub fn solid_setup_as(
     }
     let pst = Pst::from_name(p.str(k.pst)).expect("checked choice");
     let name = SolidSchemeName::from_name(p.str(k.scheme)).expect("checked choice");
+    if p.str(k.surface_shift) != "normal" && pst == Pst::None {
+        return Err(format!(
+            "scene `{scene}`: parameter `{}` = {}: only a shifting technique reads it, not `{}` = none",
+            k.surface_shift,
+            p.str(k.surface_shift),
+            k.pst
+        ));
+    }
     let settings = SolidSettings {
         pst,
         corrections: p.str(k.corrections) == "all",
@@ -220,6 +261,21 @@ pub fn solid_setup_as(
         u_ref,
         w_dx: kernel.w(dx, h),
         gravity,
+        gradient: SolidGradient::from_name(p.str(k.gradient)).expect("checked choice"),
+        surface_shift: SurfaceShift::from_name(p.str(k.surface_shift)).expect("checked choice"),
+        p_ref: match p.float(k.gtvf_p_ref) {
+            0.0 => material.bulk_modulus(),
+            p_ref if name == SolidSchemeName::Gtvf => p_ref,
+            p_ref => {
+                return Err(format!(
+                    "scene `{scene}`: parameter `{}` = {p_ref:?}: only `{}` = gtvf reads it, not `{}` = {}",
+                    k.gtvf_p_ref,
+                    k.scheme,
+                    k.scheme,
+                    p.str(k.scheme)
+                ))
+            }
+        },
     };
     let scheme = name.solid_scheme(&settings).map_err(|e| format!("scene `{scene}`: {e}"))?;
     Ok(SolidSetup { material, scheme, kernel, dx, h })

@@ -26,13 +26,19 @@ pub struct Fracture {
 }
 
 /// The worst of [`detect`] over a run: the largest cluster count and the largest gap seen,
-/// for the `clusters_max` and `max_gap` metrics of the solid scenes.
+/// for the `clusters_max` and `max_gap` metrics of the solid scenes, and the time the body
+/// was first seen in more clusters than intact (`fracture_time`), where the scene follows
+/// it ([`observe_at`](Self::observe_at)). A run that blows up after it fractured keeps all
+/// three: they are running records, valid before the end.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Worst {
     /// The largest number of clusters seen.
     pub clusters_max: usize,
     /// The largest nearest-neighbour distance seen, in units of `dx`.
     pub max_gap: f64,
+    /// The first time the body was seen in more clusters than intact.
+    #[serde(default)]
+    pub fractured_at: Option<f64>,
 }
 
 impl Worst {
@@ -44,6 +50,22 @@ impl Worst {
         f
     }
 
+    /// [`observe`](Self::observe) at time `t`, recording the first time the particles fall
+    /// into more than `intact` clusters (1 for one body; 2 for two bodies apart).
+    pub fn observe_at<const D: usize>(
+        &mut self,
+        t: f64,
+        x: &[Vector<D>],
+        (dx, link): (f64, f64),
+        intact: usize,
+    ) -> Fracture {
+        let f = self.observe(x, dx, link);
+        if f.clusters > intact && self.fractured_at.is_none() {
+            self.fractured_at = Some(t);
+        }
+        f
+    }
+
     /// The worst so far together with [`detect`] at `x` (the end of a run, whatever the
     /// sampling), without changing the record.
     pub fn with<const D: usize>(&self, x: &[Vector<D>], dx: f64, link: f64) -> Worst {
@@ -52,9 +74,14 @@ impl Worst {
         w
     }
 
-    /// The `clusters_max` and `max_gap` metrics.
-    pub fn metrics(&self) -> [(String, f64); 2] {
-        [("clusters_max".into(), self.clusters_max as f64), ("max_gap".into(), self.max_gap)]
+    /// The `clusters_max` and `max_gap` metrics, and `fracture_time` where the body has
+    /// fractured.
+    pub fn metrics(&self) -> Vec<(String, f64)> {
+        let mut m = vec![("clusters_max".into(), self.clusters_max as f64), ("max_gap".into(), self.max_gap)];
+        if let Some(t) = self.fractured_at {
+            m.push(("fracture_time".into(), t));
+        }
+        m
     }
 }
 

@@ -9,7 +9,7 @@
 //!   from a neighbour across it ([`interactions::Coupling`]);
 //! - [`equations`]: one function per physics term, citing its equation;
 //! - [`scheme`]: what a fluid scheme is (`edac`, `tvf`, `ctvf` and their switches), and a
-//!   solid's (`ctvf`, `gtvf`, `gray`);
+//!   solid's (`ctvf`, `gtvf_pst`, `gtvf`, `gray`);
 //! - [`passes`]: the parallel loops over a body's particles (density, rates,
 //!   accelerations, free surface, IPST, a solid's rates and accelerations);
 //! - [`schedule`] and [`stages`]: the wavefront, its tuner, the warm workers and the stage

@@ -159,7 +159,11 @@ fn describe(claim: &Claim, preset: &str) -> String {
 /// One case's outcome for a metric.
 enum Outcome {
     Value(f64),
-    Diverged(f64, String),
+    /// A run that blew up at a time, why, and the metric if the run kept it: a diverged
+    /// summary keeps only running records (the worst seen so far, the time of a first
+    /// event), which can only grow or stay, so a lower bound they pass before the blow-up
+    /// holds whatever came after.
+    Diverged(f64, String, Option<f64>),
     NoMetric,
     Missing,
 }
@@ -167,7 +171,8 @@ enum Outcome {
 fn outcome(entry: &Entry, metric: &str) -> Outcome {
     match entry.summary() {
         Some(s) if s.status == Status::Diverged => {
-            Outcome::Diverged(s.final_time, s.reason.unwrap_or_default())
+            let kept = s.metrics.get(metric).copied();
+            Outcome::Diverged(s.final_time, s.reason.unwrap_or_default(), kept)
         }
         Some(s) if s.status == Status::Completed => {
             s.metrics.get(metric).copied().map(Outcome::Value).unwrap_or(Outcome::NoMetric)
@@ -244,7 +249,10 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
     }
     let show = |c: &Case, v: &Outcome| match v {
         Outcome::Value(x) => format!("{}: {}", name(c), fmt_value(*x)),
-        Outcome::Diverged(t, why) => format!("{}: diverged at t = {t:.3} s ({why})", name(c)),
+        Outcome::Diverged(t, why, None) => format!("{}: diverged at t = {t:.3} s ({why})", name(c)),
+        Outcome::Diverged(t, why, Some(x)) => {
+            format!("{}: {} before it diverged at t = {t:.3} s ({why})", name(c), fmt_value(*x))
+        }
         Outcome::NoMetric => format!("{}: no `{metric}`", name(c)),
         Outcome::Missing => format!("{}: no result", name(c)),
     };
@@ -267,6 +275,11 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
                             String::new()
                         };
                         format!("{}{mark}", show(c, v))
+                    }
+                    // A running record over a lower bound only: it passed before the blow-up
+                    // and cannot fall back.
+                    Outcome::Diverged(_, _, Some(x)) if max.is_none() && min.is_some_and(|m| *x >= m) => {
+                        show(c, v)
                     }
                     other => {
                         ok = false;

@@ -640,6 +640,12 @@ figure = "prof_u"
 claim = "It is close at the paper's lattices."
 test = { metric = "l1_velocity_final", max = 0.15 }
 source = "A marker's size."
+[[claims]]
+figure = "prof_u"
+claim = "It is off."
+preset = "quick"
+test = { metric = "l1_velocity_final", min = 0.05 }
+source = "A marker's size."
 "#;
 
     /// The trade figures' note on the kinds of CPU of their wall times: one, several (with
@@ -733,7 +739,7 @@ source = "A marker's size."
                 && md.contains("At the `quick` preset, not the paper's resolutions: not reproduced"),
             "{md}"
         );
-        assert_eq!(r.items[0].item.verdicts.len(), 3);
+        assert_eq!(r.items[0].item.verdicts.len(), 4);
 
         // A case without its result is left out of the figure and named as missing; the
         // claims on it are not run.
@@ -767,6 +773,25 @@ source = "A marker's size."
             "{}",
             r.verdicts[0].own.detail
         );
+
+        // A diverged case that kept the metric as a running record: a lower bound it passed
+        // before blowing up holds; an upper bound is not met by a run that blew up.
+        Summary {
+            steps: 4,
+            final_time: 0.19,
+            status: Status::Diverged,
+            reason: Some("NaN".into()),
+            step: Some(4),
+            metrics: [("l1_velocity_final".to_string(), 0.1)].into(),
+            undefined_metrics: Vec::new(),
+            ..completed(p.cases[1].params.to_json(), 256, 0.0)
+        }
+        .write(&e.dir)
+        .unwrap();
+        let r = regenerate(&p, &output, &manuscript).unwrap();
+        let v: Vec<&Judgement> = r.verdicts.iter().map(|v| &v.own).collect();
+        assert_eq!((v[1].verdict, v[3].verdict), (Verdict::NotReproduced, Verdict::Reproduced), "{v:?}");
+        assert!(v[1].detail.contains("16 x 16: 0.100 before it diverged at t = 0.190 s (NaN)"), "{}", v[1].detail);
     }
 
     /// A finished case with snapshots at t = 0, 0.5004 and 1.0 (pressure 0, 1, 2 and a

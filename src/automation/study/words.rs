@@ -18,6 +18,7 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("scheme", "tvf") => "TVF".into(),
         ("scheme", "ctvf") => "CTVF".into(),
         ("scheme", "gtvf") => "GTVF".into(),
+        ("scheme", "gtvf_pst") => "GTVF's equations".into(),
         ("scheme", "gray") => "Gray et al. (artificial stress)".into(),
         ("pst", "sun") => "SPST".into(),
         ("pst", "ipst") => "IPST".into(),

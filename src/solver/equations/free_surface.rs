@@ -49,6 +49,22 @@ pub fn adjust_shift<const D: usize>(shift: Vector<D>, surface: bool, near: bool,
     }
 }
 
+/// Eq. (44) as the authors' code applies it to solids (`ComputeAuHatETVFSun2019Solid`,
+/// `AdjustPositionIPST`): zero on the surface; near it, the normal component removed only
+/// when it points out of the body (`shift . n > 0`, the normal pointing outwards), so that
+/// a shift into the body is kept whole.
+#[inline(always)]
+pub fn adjust_shift_outward<const D: usize>(shift: Vector<D>, surface: bool, near: bool, n: &Vector<D>) -> Vector<D> {
+    let out = shift.dot(n);
+    if surface {
+        Vector::zeros()
+    } else if near && out > 0.0 {
+        shift - n * out
+    } else {
+        shift
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -60,6 +76,12 @@ mod tests {
         assert_eq!(adjust_shift(s, true, true, &n), Vector::<2>::zeros());
         assert_eq!(adjust_shift(s, false, true, &n), Vector::<2>::new(0.3, 0.0));
         assert_eq!(adjust_shift(s, false, false, &n), s);
+        assert_eq!(adjust_shift_outward(s, true, true, &n), Vector::<2>::zeros());
+        assert_eq!(adjust_shift_outward(s, false, true, &n), Vector::<2>::new(0.3, 0.0));
+        let inwards = Vector::<2>::new(0.3, -0.4);
+        assert_eq!(adjust_shift_outward(inwards, false, true, &n), inwards);
+        assert_eq!(adjust_shift(inwards, false, true, &n), Vector::<2>::new(0.3, 0.0));
+        assert_eq!(adjust_shift_outward(s, false, false, &n), s);
         assert_eq!(cut_normal(Vector::<2>::new(0.1, 0.0), 1.0), Vector::<2>::zeros());
         assert_eq!(cut_normal(Vector::<2>::new(3.0, 4.0), 1.0), Vector::<2>::new(0.6, 0.8));
     }

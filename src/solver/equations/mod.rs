@@ -58,6 +58,13 @@ impl<const D: usize> Pair<D> {
     pub fn with_laplacian(xij: Vector<D>, r2: f64, h: f64, wij: f64, grad_factor: f64, lap: f64) -> Self {
         Self { xij, r2, h, wij, dwij: xij * grad_factor, inv_r2_eps: 1.0 / (r2 + eps2(h)), lap }
     }
+
+    /// The pair seen by a particle whose kernel gradient is corrected by `l` (Bonet & Lok:
+    /// `grad W` becomes `l grad W`, [`solid::correction_matrix`]); nothing else changes.
+    #[inline(always)]
+    pub fn corrected(&self, l: &crate::solver::math::Matrix<D>) -> Self {
+        Self { dwij: l * self.dwij, ..*self }
+    }
 }
 
 /// The values of one particle a term may read, gathered once per particle and pass, with

@@ -3,6 +3,7 @@
 //! al. (2019), all expressed as a homogenisation acceleration (du/dt)_c (CTVF sec. 3.3).
 
 use super::{Pair, Point};
+use crate::solver::kernel::ScaledKernel;
 use crate::solver::math::Vector;
 
 /// Adami et al. (2013) background-pressure acceleration (CTVF eq. 20) in the volume form
@@ -24,6 +25,25 @@ pub fn sun2019<const D: usize>(b: &Point<D>, ab: &Pair<D>, w_dx: f64, r: f64, n:
 #[inline(always)]
 pub fn sun2019_volume<const D: usize>(v_b: f64, ab: &Pair<D>, w_dx: f64, r: f64, n: i32) -> Vector<D> {
     ab.dwij * (v_b * (1.0 + r * powi_small(ab.wij / w_dx, n)))
+}
+
+/// GTVF's background pressure of a solid particle at pressure `p` (Zhang, Hu & Adams
+/// 2017): `p0_a = min(10 |p_a|, p_ref)`, as the authors' `GTVFSetP0` sets it with `p_ref`
+/// the bulk modulus. It vanishes with the pressure at a free surface, where GTVF has no
+/// other surface treatment (CTVF sec. 3.4).
+#[inline(always)]
+pub fn gtvf_background_pressure(p: f64, p_ref: f64) -> f64 {
+    (10.0 * p.abs()).min(p_ref)
+}
+
+/// Neighbour `b`'s share of GTVF's homogenisation sum, CTVF eq. (20) as the authors'
+/// `ComputeAuHatGTVF` evaluates it: `m_b grad W(x_ab, h/2)`, the kernel gradient taken at
+/// half the smoothing length (`half`). The acceleration is `-p0_a / rho_a^2` times the sum
+/// ([`gtvf_background_pressure`]).
+#[inline(always)]
+pub fn gtvf_pair<const D: usize>(m_b: f64, ab: &Pair<D>, half: &ScaledKernel) -> Vector<D> {
+    let (_, grad_factor) = half.w_and_grad_factor(ab.r2.sqrt());
+    ab.xij * (m_b * grad_factor)
 }
 
 /// `x^n` for a small non-negative `n` by repeated multiplication (`powi` with a

@@ -143,16 +143,62 @@ pub fn momentum<const D: usize>(a: &SolidPoint<D>, b: &SolidPoint<D>, ab: &Pair<
     (pressure - deviatoric) * -b.m
 }
 
-/// The second invariant of a deviatoric stress, `J2 = sigma':sigma' / 2` (in 2D plane
-/// strain, of the in-plane components tracked).
+/// The kernel-gradient correction (Bonet & Lok 1999, eq. 47; Randles & Libersky 1996), one
+/// neighbour's share of the matrix it inverts: `V_b grad W (x) x_ba`, with
+/// `x_ba = x_b - x_a = -x_ab`. Summed over a full support it is the identity (a lattice's
+/// first moment); at a free surface, where half the support is empty, it is not, and the
+/// SPH gradient of a linear field is off by it.
+#[inline(always)]
+pub fn correction_moment<const D: usize>(vol_b: f64, ab: &Pair<D>) -> Matrix<D> {
+    ab.dwij * ab.xij.transpose() * -vol_b
+}
+
+/// The correction matrix `L_a = (sum_b V_b grad W (x) x_ba)^-1` from the summed
+/// [`correction_moment`], so that the corrected gradient `L_a grad W_ab` makes the SPH
+/// gradient of any linear field exact (`sum_b V_b (f_b - f_a) (x) L_a grad W = grad f`).
+/// A particle whose neighbours do not span the space (a chain, a lone particle: the moment
+/// singular, or so nearly that an entry of its inverse exceeds 1e3, where a full support
+/// gives 1 and a corner's quarter support about 4) keeps the plain gradient (the identity).
+#[inline(always)]
+pub fn correction_matrix<const D: usize>(moment: &Matrix<D>) -> Matrix<D> {
+    match moment.try_inverse() {
+        Some(l) if l.iter().all(|v| v.abs() <= 1e3) => l,
+        _ => Matrix::identity(),
+    }
+}
+
+/// Eq. (30) with each particle's corrected kernel gradient: `-m_b [(p_a/rho_a^2 - sigma'_a
+/// /rho_a^2) g_a + (p_b/rho_b^2 - sigma'_b/rho_b^2) g_b]` with `g_a = L_a grad W_ab`,
+/// `g_b = L_b grad W_ab` ([`correction_matrix`]): the symmetric form of Bonet & Lok's
+/// corrected SPH (their eq. 51) in which the pair's forces on a and b are equal and
+/// opposite, so momentum is conserved; with `L = I` it is [`momentum`].
+#[inline(always)]
+pub fn momentum_corrected<const D: usize>(
+    a: &SolidPoint<D>,
+    b: &SolidPoint<D>,
+    (g_a, g_b): (Vector<D>, Vector<D>),
+) -> Vector<D> {
+    let (ia, ib) = (1.0 / (a.rho * a.rho), 1.0 / (b.rho * b.rho));
+    let pressure = g_a * (a.p * ia) + g_b * (b.p * ib);
+    let deviatoric = a.s * g_a * ia + b.s * g_b * ib;
+    (pressure - deviatoric) * -b.m
+}
+
+/// The second invariant of a deviatoric stress, `J2 = sigma':sigma' / 2`. In 2D plane
+/// strain the deviator has an out-of-plane component too: the stress deviator's trace is
+/// zero, so `sigma'_zz = -(sigma'_xx + sigma'_yy)`, which the in-plane components tracked
+/// (eq. 4 subtracts a third of the trace) determine; it counts in J2, and so in the von
+/// Mises stress and the yield test of sec. 4.7.
 #[inline(always)]
 pub fn j2<const D: usize>(s: &Matrix<D>) -> f64 {
-    0.5 * s.component_mul(s).sum()
+    let out_of_plane = if D == 2 { s.trace().powi(2) } else { 0.0 };
+    0.5 * (s.component_mul(s).sum() + out_of_plane)
 }
 
 /// The radial return of an elastic-perfectly-plastic material onto the von Mises yield
 /// surface (CTVF sec. 4.7): `sigma' <- sqrt(beta) sigma'` with
-/// `beta = min(Y0^2 / (3 J2), 1)`. The paper prints the factor as beta; scaling sigma' by f
+/// `beta = min(Y0^2 / (3 J2), 1)`, J2 with the out-of-plane component in 2D ([`j2`]),
+/// which scales with the in-plane ones. The paper prints the factor as beta; scaling sigma' by f
 /// scales J2 by f^2, so the return onto `sqrt(3 J2) = Y0` takes sqrt(beta)
 /// (`shared/SEED-NOTES.md`, "Section 4.7").
 #[inline(always)]
@@ -238,6 +284,21 @@ mod tests {
         assert!((von_mises(&r) - y0).abs() < 1e-9 * y0, "{}", von_mises(&r));
         let ratio = r.component_div(&beyond);
         assert!(ratio.iter().all(|&f| (f - ratio[0]).abs() < 1e-12), "direction kept");
+    }
+
+    /// Plane strain by hand: the in-plane deviator diag(2, 1) (sigma'_zz = -3) has
+    /// J2 = (4 + 1 + 9) / 2 = 7, so sqrt(3 J2) = sqrt(21); returned onto Y0 = 3 it becomes
+    /// diag(2, 1) 3 / sqrt(21), whose von Mises stress (out-of-plane part included) is 3.
+    #[test]
+    fn plane_strain_j2_counts_the_out_of_plane_deviator() {
+        let s = Matrix::<2>::new(2.0, 0.0, 0.0, 1.0);
+        assert!((j2(&s) - 7.0).abs() < 1e-15);
+        assert!((von_mises(&s) - 21f64.sqrt()).abs() < 1e-14);
+        let r = radial_return(&s, 3.0);
+        assert!((r - s * (3.0 / 21f64.sqrt())).norm() < 1e-15, "{r}");
+        assert!((von_mises(&r) - 3.0).abs() < 1e-14);
+        // A pure shear has no out-of-plane part: J2 = tau^2.
+        assert!((j2(&Matrix::<2>::new(0.0, 2.0, 2.0, 0.0)) - 4.0).abs() < 1e-15);
     }
 
     /// Eqs. (68)-(70) by hand: a uniaxial stress of -3 has von Mises stress 3; a pure shear

@@ -13,7 +13,7 @@ use super::lists::{build_kernel_list_cross, KernelList};
 use super::Coupling;
 use crate::solver::equations::solid::SolidPoint;
 use crate::solver::kernel::Kernel;
-use crate::solver::math::Vector;
+use crate::solver::math::{Matrix, Vector};
 use crate::solver::nnps::CellList;
 use crate::solver::systems::{Body, ElasticSolid, Work};
 
@@ -54,6 +54,8 @@ pub struct Other<'a, const D: usize> {
     pub x: &'a [Vector<D>],
     /// Views.
     pub points: &'a [SolidPoint<D>],
+    /// Their kernel-gradient corrections (empty unless the solid's gradient is corrected).
+    pub correction: &'a [Matrix<D>],
     /// For every particle of the solid summing, its neighbours among them.
     pub list: &'a KernelList<D>,
 }
@@ -92,8 +94,21 @@ impl<'a, const D: usize> Continuum<'a, D> {
         self.idx.iter().map(move |&k| {
             let Coupling::SolidContinuum(c) = &couplings[k] else { unreachable!("a continuum coupling") };
             let x = &bodies[c.src].as_solid().expect("a solid").x;
-            let points = &work[c.src].as_solid().expect("a solid's work").passes.points;
-            Other { x, points, list: &c.list }
+            let passes = &work[c.src].as_solid().expect("a solid's work").passes;
+            Other { x, points: &passes.points, correction: &passes.correction, list: &c.list }
+        })
+    }
+
+    /// The other solids of the couplings of indices `idx` as they are (before their views
+    /// are gathered), each with the list of its particles near each of this solid's.
+    pub fn sources(
+        couplings: &'a [Coupling<D>],
+        idx: &'a [usize],
+        bodies: &'a [Body<D>],
+    ) -> impl Iterator<Item = (&'a KernelList<D>, &'a ElasticSolid<D>)> + 'a {
+        idx.iter().map(move |&k| {
+            let Coupling::SolidContinuum(c) = &couplings[k] else { unreachable!("a continuum coupling") };
+            (&c.list, bodies[c.src].as_solid().expect("a solid"))
         })
     }
 }

@@ -4,11 +4,11 @@
 //! The switches are read once per pass, outside the particle loop.
 
 use crate::solver::equations::artificial_viscosity::monaghan_values;
-use crate::solver::equations::shifting::sun2019_volume;
+use crate::solver::equations::shifting::{gtvf_pair, sun2019_volume};
 use crate::solver::equations::solid::{self, SolidPoint};
 use crate::solver::equations::Pair;
 use crate::solver::interactions::lists::{build_kernel_list, KernelList};
-use crate::solver::kernel::Kernel;
+use crate::solver::kernel::{Kernel, ScaledKernel};
 use crate::solver::math::{Matrix, Vector};
 use crate::solver::nnps::CellList;
 use crate::solver::systems::ElasticSolid;
@@ -103,7 +103,8 @@ impl RateTerms {
 pub struct AccelSums<const D: usize> {
     /// du/dt without the body force: eq. (30) with the artificial viscosity.
     pub acc: Vector<D>,
-    /// The sum of Sun's shifting, eq. (36), before its prefactor.
+    /// The sum of the homogenisation before its prefactor: Sun's shifting, eq. (36), or
+    /// GTVF's background pressure, eq. (20).
     pub ac: Vector<D>,
 }
 
@@ -116,6 +117,8 @@ pub struct AccelTerms {
     pub viscosity: Option<(f64, f64)>,
     /// Sun's shifting `(W(dx), R, n)`, eq. (36).
     pub sun: Option<(f64, f64, i32)>,
+    /// GTVF's homogenisation, eq. (20), with the kernel at h/2.
+    pub gtvf: Option<ScaledKernel>,
     /// Monaghan's artificial stress `(W(dx), n)` (Gray et al. 2001, eq. 4.10).
     pub artificial_stress: Option<(f64, i32)>,
 }
@@ -131,6 +134,33 @@ impl AccelTerms {
         ab: &Pair<D>,
     ) {
         s.acc += solid::momentum(a, b, ab) * self.momentum;
+        self.beside_momentum(s, a, b, ab);
+    }
+
+    /// [`neighbour`](Self::neighbour) with the kernel gradient corrected: eq. (30) with
+    /// `a`'s correction `l_a` and `b`'s `l_b` ([`solid::momentum_corrected`]); the artificial
+    /// viscosity and stress and the shifting as they are.
+    #[inline(always)]
+    pub fn neighbour_corrected<const D: usize>(
+        &self,
+        s: &mut AccelSums<D>,
+        (a, l_a): (&SolidPoint<D>, &Matrix<D>),
+        (b, l_b): (&SolidPoint<D>, &Matrix<D>),
+        ab: &Pair<D>,
+    ) {
+        s.acc += solid::momentum_corrected(a, b, (l_a * ab.dwij, l_b * ab.dwij)) * self.momentum;
+        self.beside_momentum(s, a, b, ab);
+    }
+
+    /// The terms other than eq. (30)'s pair term.
+    #[inline(always)]
+    fn beside_momentum<const D: usize>(
+        &self,
+        s: &mut AccelSums<D>,
+        a: &SolidPoint<D>,
+        b: &SolidPoint<D>,
+        ab: &Pair<D>,
+    ) {
         if let Some((alpha, c)) = self.viscosity {
             s.acc += monaghan_values(a.u - b.u, (a.rho, b.rho), b.m, ab, alpha, c);
         }
@@ -139,6 +169,9 @@ impl AccelTerms {
         }
         if let Some((w_dx, r, n)) = self.sun {
             s.ac += sun2019_volume(b.vol, ab, w_dx, r, n);
+        }
+        if let Some(half) = &self.gtvf {
+            s.ac += gtvf_pair(b.m, ab, half);
         }
     }
 }

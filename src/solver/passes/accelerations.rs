@@ -5,7 +5,7 @@
 
 use super::free_surface::SurfaceFields;
 use super::{FluidPasses, Gatherer, Sources, MIN_LEN};
-use crate::solver::equations::{free_surface, Pair, Point};
+use crate::solver::equations::{Pair, Point};
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::fluid_fluid::{AccelSums, AccelTerms};
 use crate::solver::interactions::lists::KernelList;
@@ -104,7 +104,7 @@ pub(crate) fn write_accelerations<const D: usize>(
         }
         if let Some(fs) = surface {
             // eq. (44)
-            ac = free_surface::adjust_shift(ac, fs.surface[i], fs.near[i], &fs.normal[i]);
+            ac = fs.adjust(i, ac);
         }
         (acc + g, ac)
     };

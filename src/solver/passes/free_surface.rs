@@ -2,7 +2,7 @@
 //! the particles next to them, recomputed every step for bodies that declare a free surface.
 
 use super::Particles;
-use crate::solver::equations::free_surface::{cut_normal, in_normal_cone, normal, smoothed_normal};
+use crate::solver::equations::free_surface::{self, cut_normal, in_normal_cone, normal, smoothed_normal};
 use crate::solver::equations::Point;
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::lists::KernelList;
@@ -27,6 +27,9 @@ pub struct SurfaceFields<const D: usize> {
     pub surface: Vec<bool>,
     /// Not on it, but with a surface particle among its neighbours (h_b < h, Algorithm 1).
     pub near: Vec<bool>,
+    /// Near the surface, remove a shift's normal component only when it points out of the
+    /// body (the authors' code for solids) rather than always (eq. 44 as printed).
+    pub outward_only: bool,
 }
 
 /// Particle `j` of mass `m` and density `rho` as the normals read it (its volume).
@@ -36,6 +39,18 @@ fn volume_point<const D: usize>(m: f64, rho: f64) -> Point<D> {
 }
 
 impl<const D: usize> SurfaceFields<D> {
+    /// Particle `i`'s shift (an acceleration or a displacement) adjusted at the free
+    /// surface: eqs. (44)-(45), or as the authors' code adjusts a solid's
+    /// ([`outward_only`](Self::outward_only)).
+    #[inline(always)]
+    pub fn adjust(&self, i: usize, shift: Vector<D>) -> Vector<D> {
+        if self.outward_only {
+            free_surface::adjust_shift_outward(shift, self.surface[i], self.near[i], &self.normal[i])
+        } else {
+            free_surface::adjust_shift(shift, self.surface[i], self.near[i], &self.normal[i])
+        }
+    }
+
     /// Detects the surface of the body `particles` (its list `nl`, its `boundaries` as
     /// neighbours) whose reference density is `rho0`: eq. (42) with its cut-off, eq. (43),
     /// the low-density rule (summation density below rho0 / 2), the 60-degree test over the

@@ -16,7 +16,7 @@
 
 use super::free_surface::SurfaceFields;
 use super::MIN_LEN;
-use crate::solver::equations::{free_surface, shifting, Point};
+use crate::solver::equations::{shifting, Point};
 use crate::solver::interactions::fluid_boundary::Boundaries;
 use crate::solver::interactions::lists::KernelList;
 use crate::solver::kernel::{Kernel, ScaledKernel};
@@ -234,7 +234,7 @@ fn move_slab<const D: usize>(
         let mut dr = d * scale;
         if let Some(fs) = surface {
             // eq. (45)
-            dr = free_surface::adjust_shift(dr, fs.surface[i], fs.near[i], &fs.normal[i]);
+            dr = fs.adjust(i, dr);
         }
         // Not wrapped: the list's image shifts refer to the unwrapped positions.
         *next = x + dr;

@@ -13,7 +13,7 @@ pub mod settings;
 pub mod solid;
 
 pub use settings::{FluidSettings, OptionError, SchemeOptions};
-pub use solid::{GradientVelocity, SolidScheme, SolidSchemeName, SolidSettings, SolidShifting};
+pub use solid::{GradientVelocity, GtvfBackground, SolidGradient, SurfaceShift, SolidScheme, SolidSchemeName, SolidSettings, SolidShifting};
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

@@ -1,7 +1,7 @@
 //! The schemes of an elastic solid: which velocity its velocity gradient is taken of,
 //! whether the transport-velocity correction terms are evaluated, how its particles are
-//! homogenised, and its artificial viscosity and stress. `ctvf`, `gtvf` and `gray` are
-//! values of [`SolidScheme`] built from one [`SolidSettings`]
+//! homogenised, and its artificial viscosity and stress. `ctvf`, `gtvf_pst`, `gtvf` and
+//! `gray` are values of [`SolidScheme`] built from one [`SolidSettings`]
 //! ([`SolidSchemeName::solid_scheme`]), not separate code paths: they differ in switches.
 
 use super::{paper, IpstTest, Pst, Shifting};
@@ -15,8 +15,13 @@ pub enum SolidSchemeName {
     /// CTVF (Adepu & Ramachandran): the velocity gradient of the momentum velocity u
     /// (eq. 31) and the transport-velocity correction terms of eqs. (25) and (32).
     Ctvf,
-    /// GTVF (Zhang, Hu & Adams 2017): the velocity gradient of the transport velocity u~,
-    /// no correction terms (CTVF sec. 4.4 and 5 compare the two).
+    /// GTVF's solid equations under the shifting `pst` names: the velocity gradient of the
+    /// transport velocity u~, no correction terms, particles shifted by Sun's shifting or
+    /// IPST (CTVF fig. 18b's "GTVF with SPST").
+    GtvfPst,
+    /// GTVF (Zhang, Hu & Adams 2017) as its authors run it: [`GtvfPst`](Self::GtvfPst)'s equations
+    /// homogenised by GTVF's own background pressure ([`GtvfBackground`]) instead of a
+    /// shifting technique (CTVF fig. 18a, sec. 4.5's GTVF curve).
     Gtvf,
     /// Gray, Monaghan & Swift (2001): no transport velocity (no shifting), Monaghan's
     /// artificial stress against the tensile instability, as PySPH's
@@ -26,6 +31,7 @@ pub enum SolidSchemeName {
 
 named_choices!(SolidSchemeName {
     Ctvf => "ctvf",
+    GtvfPst => "gtvf_pst",
     Gtvf => "gtvf",
     Gray => "gray",
 });
@@ -40,6 +46,55 @@ pub struct ArtificialStress {
     pub n: i32,
     /// Kernel value at the initial spacing, W(dx).
     pub w_dx: f64,
+}
+
+/// The kernel gradient of a solid's sums: the paper's, or corrected (Bonet & Lok 1999).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SolidGradient {
+    /// `grad W` as it is (CTVF eqs. 25, 30-32).
+    Paper,
+    /// `L_a grad W` with `L_a = (sum_b V_b grad W (x) x_ba)^-1`
+    /// ([`correction_matrix`](crate::solver::equations::solid::correction_matrix)) in the
+    /// particle's density and stress rates, and each particle's own in the momentum equation
+    /// ([`momentum_corrected`](crate::solver::equations::solid::momentum_corrected)): the
+    /// gradient of a linear field is then exact at a free surface too, where the paper's
+    /// sees half a support. Beyond the paper.
+    Corrected,
+}
+
+named_choices!(SolidGradient {
+    Paper => "paper",
+    Corrected => "corrected",
+});
+
+/// How a solid's shift is kept from the free surface next to it (the surface particles
+/// themselves are never shifted).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceShift {
+    /// Eqs. (44)-(45) as printed: the normal component removed.
+    #[default]
+    Normal,
+    /// As the authors' code does for solids: the normal component removed only when it
+    /// points out of the body
+    /// ([`adjust_shift_outward`](crate::solver::equations::free_surface::adjust_shift_outward)).
+    Outward,
+}
+
+named_choices!(SurfaceShift {
+    Normal => "normal",
+    Outward => "outward",
+});
+
+/// GTVF's homogenisation (Zhang, Hu & Adams 2017; CTVF eq. 20 as the authors' code
+/// `ComputeAuHatGTVF` evaluates it): `(du/dt)_c = -p0_a / rho_a^2 sum_b m_b grad W(x_ab, h/2)`
+/// with the particle's background pressure `p0_a = min(10 |p_a|, p_ref)`
+/// ([`gtvf_background_pressure`](crate::solver::equations::shifting::gtvf_background_pressure)).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct GtvfBackground {
+    /// The cap `p_ref` of the background pressure (Pa): the bulk modulus in the authors' code.
+    pub p_ref: f64,
 }
 
 /// Which velocity the velocity gradient of eq. (31) is taken of.
@@ -88,6 +143,9 @@ pub struct SolidScheme {
     /// from the initial configuration when the simulation starts.
     #[serde(default)]
     pub ipst: Option<Shifting>,
+    /// GTVF's background-pressure homogenisation, the third way to make u~ (`gtvf`).
+    #[serde(default)]
+    pub background_pressure: Option<GtvfBackground>,
     /// Monaghan's artificial viscosity alpha (eq. 28), if any.
     pub artificial_viscosity: Option<f64>,
     /// Monaghan's artificial stress (`gray`), if any.
@@ -95,14 +153,21 @@ pub struct SolidScheme {
     pub artificial_stress: Option<ArtificialStress>,
     /// Detect the free surface (sec. 3.4) and keep the shifting tangential near it (eq. 44).
     pub free_surface: bool,
+    /// How the shift near the free surface is kept from it.
+    #[serde(default)]
+    pub surface_shift: SurfaceShift,
+    /// The kernel-gradient correction ([`SolidGradient::Corrected`]); false: the paper's.
+    #[serde(default)]
+    pub kernel_correction: bool,
     /// Body force per unit mass.
     pub gravity: [f64; 3],
 }
 
 impl SolidScheme {
-    /// Whether the particles move with a transport velocity u~ (Sun's shifting or IPST).
+    /// Whether the particles move with a transport velocity u~ (Sun's shifting, IPST or
+    /// GTVF's background pressure).
     pub fn transports(&self) -> bool {
-        self.shifting.is_some() || self.ipst.is_some()
+        self.shifting.is_some() || self.ipst.is_some() || self.background_pressure.is_some()
     }
 
     /// Gravity as a `D`-vector.
@@ -116,7 +181,7 @@ impl SolidScheme {
 pub struct SolidSettings {
     /// Particle shifting: Sun 2019, IPST or none.
     pub pst: Pst,
-    /// The correction terms (read by `ctvf`; `gtvf` has none).
+    /// The correction terms (read by `ctvf`; the others have none).
     pub corrections: bool,
     /// Artificial viscosity alpha of eq. (28); 0: none.
     pub alpha: f64,
@@ -126,18 +191,34 @@ pub struct SolidSettings {
     pub w_dx: f64,
     /// Body force per unit mass.
     pub gravity: [f64; 3],
+    /// The kernel gradient: the paper's or corrected.
+    pub gradient: SolidGradient,
+    /// The cap `p_ref` of GTVF's background pressure (Pa; read by `gtvf` only).
+    pub p_ref: f64,
+    /// How the shift near the free surface is kept from it (Sun's shifting and IPST).
+    pub surface_shift: SurfaceShift,
 }
 
 impl SolidSchemeName {
-    /// The composition this name stands for. `gray` has no transport velocity, so it takes
-    /// `pst` = none only. IPST runs at the paper's tolerance and cap ([`paper`]) with the
-    /// reference speed `u_ref` as its U_max.
+    /// The composition this name stands for. `gray` has no transport velocity and `gtvf`
+    /// homogenises with its own background pressure, so both take `pst` = none only. IPST
+    /// runs at the paper's tolerance and cap ([`paper`]) with the reference speed `u_ref` as
+    /// its U_max.
     pub fn solid_scheme(self, s: &SolidSettings) -> Result<SolidScheme, String> {
-        if self == SolidSchemeName::Gray && s.pst != Pst::None {
+        let own = match self {
+            SolidSchemeName::Gray => Some("has no transport velocity to shift with"),
+            SolidSchemeName::Gtvf => Some("homogenises with its own background pressure (Zhang et al. 2017)"),
+            _ => None,
+        };
+        if let (Some(why), true) = (own, s.pst != Pst::None) {
             return Err(format!(
-                "`scheme` = gray has no transport velocity to shift with: `pst` = {} is refused (give `pst` = none)",
+                "`scheme` = {} {why}: `pst` = {} is refused (give `pst` = none)",
+                Self::NAMES[self as usize],
                 Pst::NAMES[s.pst as usize]
             ));
+        }
+        if self == SolidSchemeName::Gtvf && !(s.p_ref > 0.0 && s.p_ref.is_finite()) {
+            return Err(format!("GTVF's background pressure cap p_ref = {:?} Pa must be positive and finite", s.p_ref));
         }
         let shifting =
             (s.pst == Pst::Sun).then_some(SolidShifting { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 });
@@ -149,10 +230,15 @@ impl SolidSchemeName {
             chi_ref: f64::NAN, // measured on the initial configuration
             test: IpstTest::default(),
         });
-        let transports = shifting.is_some() || ipst.is_some();
+        let background_pressure =
+            (self == SolidSchemeName::Gtvf).then_some(GtvfBackground { p_ref: s.p_ref });
+        // Sun's shifting and IPST keep the free surface (sec. 3.4); GTVF's background
+        // pressure vanishes there by itself.
+        let shifted = shifting.is_some() || ipst.is_some();
+        let transports = shifted || background_pressure.is_some();
         let (gradient, corrections) = match self {
             SolidSchemeName::Ctvf => (GradientVelocity::Momentum, s.corrections),
-            SolidSchemeName::Gtvf => (GradientVelocity::Transport, false),
+            SolidSchemeName::GtvfPst | SolidSchemeName::Gtvf => (GradientVelocity::Transport, false),
             SolidSchemeName::Gray => (GradientVelocity::Momentum, false),
         };
         let artificial_stress =
@@ -163,10 +249,13 @@ impl SolidSchemeName {
             corrections: corrections && transports,
             shifting,
             ipst,
+            background_pressure,
             artificial_viscosity: (s.alpha > 0.0).then_some(s.alpha),
             artificial_stress,
-            free_surface: transports,
+            free_surface: shifted,
+            surface_shift: s.surface_shift,
             gravity: s.gravity,
+            kernel_correction: s.gradient == SolidGradient::Corrected,
         })
     }
 }
@@ -190,6 +279,9 @@ impl fmt::Display for SolidScheme {
             "  deviatoric stress: Jaumann rate, eqs. (4), (32); velocity gradient of {v}{}",
             if self.corrections { "; transport terms of eq. (32)" } else { "" }
         )?;
+        if self.kernel_correction {
+            writeln!(f, "  kernel gradient: corrected, L grad W (Bonet & Lok 1999; beyond the paper)")?;
+        }
         match self.artificial_viscosity {
             Some(a) => writeln!(f, "  momentum: eq. (30), artificial viscosity alpha = {a} (eq. 28)")?,
             None => writeln!(f, "  momentum: eq. (30)")?,
@@ -204,12 +296,22 @@ impl fmt::Display for SolidScheme {
                 s.ma_c0,
                 s.r,
                 s.n,
-                if self.free_surface { "; tangential near the free surface, eq. (44)" } else { "" }
+                match (self.free_surface, self.surface_shift) {
+                    (false, _) => "",
+                    (true, SurfaceShift::Normal) => "; tangential near the free surface, eq. (44)",
+                    (true, SurfaceShift::Outward) => "; near the free surface not outwards (eq. 44 as the authors' code applies it)",
+                }
             ),
-            None => match self.ipst {
-                Some(Shifting::Ipst { tol, max_iter, interval, .. }) => write!(
+            None => match (self.ipst, self.background_pressure) {
+                (Some(Shifting::Ipst { tol, max_iter, interval, .. }), _) => write!(
                     f,
-                    "  shifting: IPST, eqs. (37)-(41): tol = {tol}, max {max_iter} iterations, every {interval} step(s); away from the free surface (sec. 3.4)"
+                    "  shifting: IPST, eqs. (37)-(41): tol = {tol}, max {max_iter} iterations, every {interval} step(s); away from the free surface (sec. 3.4){}",
+                    if self.surface_shift == SurfaceShift::Outward { ", near it not outwards" } else { "" }
+                ),
+                (_, Some(b)) => write!(
+                    f,
+                    "  shifting: GTVF's background pressure, eq. (20) with grad W at h/2, p0 = min(10 |p|, {:.4e} Pa)",
+                    b.p_ref
                 ),
                 _ => write!(f, "  shifting: none (particles move with u)"),
             },
@@ -222,24 +324,50 @@ mod tests {
     use super::*;
 
     fn settings(pst: Pst) -> SolidSettings {
-        SolidSettings { pst, corrections: true, alpha: 1.0, u_ref: 1.0, w_dx: 1.0, gravity: [0.0; 3] }
+        SolidSettings {
+            pst,
+            corrections: true,
+            alpha: 1.0,
+            u_ref: 1.0,
+            w_dx: 1.0,
+            gravity: [0.0; 3],
+            gradient: SolidGradient::Paper,
+            p_ref: 2.0,
+            surface_shift: SurfaceShift::Normal,
+        }
     }
 
-    /// `ctvf` and `gtvf` differ in the gradient's velocity and the corrections only.
+    /// `ctvf` and `gtvf_pst` differ in the gradient's velocity and the corrections only; `gtvf`
+    /// is `gtvf_pst` homogenised by its background pressure instead of a shifting technique.
     #[test]
-    fn ctvf_and_gtvf_differ_in_two_switches() {
+    fn the_solid_schemes_differ_in_switches() {
         let c = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Sun)).unwrap();
-        let g = SolidSchemeName::Gtvf.solid_scheme(&settings(Pst::Sun)).unwrap();
+        let t = SolidSchemeName::GtvfPst.solid_scheme(&settings(Pst::Sun)).unwrap();
         assert_eq!((c.gradient, c.corrections), (GradientVelocity::Momentum, true));
-        assert_eq!((g.gradient, g.corrections), (GradientVelocity::Transport, false));
-        let same = SolidScheme { name: c.name, gradient: c.gradient, corrections: c.corrections, ..g };
+        assert_eq!((t.gradient, t.corrections), (GradientVelocity::Transport, false));
+        let same = SolidScheme { name: c.name, gradient: c.gradient, corrections: c.corrections, ..t };
         assert_eq!(same, c);
+        let g = SolidSchemeName::Gtvf.solid_scheme(&settings(Pst::None)).unwrap();
+        let as_tvf = SolidScheme {
+            name: t.name,
+            shifting: t.shifting,
+            free_surface: t.free_surface,
+            background_pressure: None,
+            ..g
+        };
+        assert_eq!(as_tvf, t);
+        assert_eq!(g.background_pressure, Some(GtvfBackground { p_ref: 2.0 }));
+        assert!(g.transports() && !g.free_surface && g.shifting.is_none() && g.ipst.is_none());
+        let e = SolidSchemeName::Gtvf.solid_scheme(&settings(Pst::Sun)).unwrap_err();
+        assert!(e.contains("`scheme` = gtvf") && e.contains("`pst` = sun"), "{e}");
+        let e = SolidSchemeName::Gtvf.solid_scheme(&SolidSettings { p_ref: 0.0, ..settings(Pst::None) }).unwrap_err();
+        assert!(e.contains("p_ref = 0.0"), "{e}");
         let ipst = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Ipst)).unwrap();
         assert!(ipst.shifting.is_none() && ipst.ipst.is_some() && ipst.transports() && ipst.corrections);
         let gray = SolidSchemeName::Gray.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(gray.shifting.is_none() && !gray.corrections && gray.artificial_stress.is_some());
         assert!(SolidSchemeName::Gray.solid_scheme(&settings(Pst::Sun)).unwrap_err().contains("gray"));
-        assert!(c.artificial_stress.is_none() && g.artificial_stress.is_none());
+        assert!(c.artificial_stress.is_none() && t.artificial_stress.is_none() && g.artificial_stress.is_none());
         let still = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(still.shifting.is_none() && !still.corrections, "no transport velocity: nothing to correct");
     }

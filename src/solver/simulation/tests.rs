@@ -8,7 +8,7 @@ use crate::solver::kernel::KernelKind;
 use crate::solver::passes::{rates, FluidPasses};
 use crate::solver::schedule::Wavefront;
 use crate::solver::scheme::{
-    Corrections, FluidSettings, Pst, SchemeName, Shifting, SolidSchemeName, SolidSettings, Transport,
+    Corrections, FluidSettings, Pst, SchemeName, Shifting, SolidGradient, SolidSchemeName, SolidSettings, Transport,
 };
 use crate::solver::systems::{FluidInit, FluidWork, SolidInit, SolidMaterial};
 
@@ -327,7 +327,7 @@ fn the_wavefront_step_is_the_sweeps_bit_for_bit() {
 /// three sub-steps a step and on none.
 #[test]
 fn momentum_crosses_the_fluid_structure_interface_without_loss() {
-    use crate::solver::scheme::{Corrections, PressureReference, SolidSchemeName, SolidSettings};
+    use crate::solver::scheme::{Corrections, PressureReference, SolidGradient, SolidSchemeName, SolidSettings};
     use crate::solver::systems::{BoundaryMaterial, SolidInit, SolidMaterial};
     for substeps in [Substeps::Fixed(3), Substeps::Fixed(1)] {
         let n = 24;
@@ -367,6 +367,9 @@ fn momentum_crosses_the_fluid_structure_interface_without_loss() {
             u_ref: 1.0,
             w_dx: kernel.w(dx, dx),
             gravity: [0.0; 3],
+            gradient: SolidGradient::Paper,
+            p_ref: 1.0,
+            surface_shift: Default::default(),
         };
         let material = SolidMaterial::new(300.0, 0.3, 1.0).unwrap();
         let boundary = BoundaryMaterial {
@@ -549,6 +552,9 @@ fn a_solid_losing_and_gaining_a_lone_particle_leaves_the_rest_bit_for_bit() {
         u_ref: 1.0,
         w_dx: kernel.w(dx, dx),
         gravity: [0.0; 3],
+        gradient: SolidGradient::Paper,
+        p_ref: 1.0,
+        surface_shift: Default::default(),
     };
     let physics = SolidSchemeName::Ctvf.solid_scheme(&settings).unwrap();
     let block = |lone: bool| {

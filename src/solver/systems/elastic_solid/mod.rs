@@ -357,7 +357,7 @@ impl<const D: usize> ElasticSolid<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::scheme::{Pst, SolidSchemeName, SolidSettings};
+    use crate::solver::scheme::{Pst, SolidGradient, SolidSchemeName, SolidSettings};
 
     fn physics() -> SolidScheme {
         let s = SolidSettings {
@@ -367,6 +367,9 @@ mod tests {
             u_ref: 1.0,
             w_dx: 1.0,
             gravity: [0.0; 3],
+            gradient: SolidGradient::Paper,
+            p_ref: 1.0,
+            surface_shift: Default::default(),
         };
         SolidSchemeName::Ctvf.solid_scheme(&s).unwrap()
     }

@@ -113,9 +113,16 @@ impl<const D: usize> BodyStages<D> for SolidStages {
         }
     }
 
+    /// The views of its particles, and their kernel-gradient corrections if the scheme
+    /// corrects the gradient (over the solids it sums across too, as they stand).
     fn gather(&self, w: &mut World<D>, i: usize) {
-        let solid = w.bodies[i].as_solid().expect("a solid");
-        w.work[i].as_solid_mut().expect("a solid's work").passes.gather(solid);
+        let World { bodies, work, couplings, .. } = w;
+        let solid = bodies[i].as_solid().expect("a solid");
+        let mine = work[i].as_solid_mut().expect("a solid's work");
+        mine.passes.gather(solid);
+        let nl = own(couplings, mine);
+        let SolidWork { passes, continuum, .. } = mine;
+        solid::kernel_correction(passes, solid, nl, Continuum::sources(couplings, continuum, bodies));
     }
 
     /// The density, pressure and deviatoric-stress rates at the current positions and
@@ -148,14 +155,14 @@ impl<const D: usize> BodyStages<D> for SolidStages {
     }
 
     /// The accelerations (eq. 30) with the external acceleration, and Sun's shifting
-    /// (eq. 36) for a step `dt`.
+    /// (eq. 36) or GTVF's background pressure (eq. 20) for a step `dt`.
     fn accelerations(&self, w: &mut World<D>, i: usize, dt: f64) {
-        let World { bodies, rates, work, couplings, .. } = w;
+        let World { bodies, rates, work, couplings, kernel, .. } = w;
         let Rates::Solid(r) = &mut rates[i] else { unreachable!("a solid's rates") };
         let solid = bodies[i].as_solid().expect("a solid");
         let mine = work[i].as_solid().expect("a solid's work");
         let continuum = Continuum::new(couplings, &mine.continuum, bodies, work);
-        solid::accelerations(&mine.passes, solid, own(couplings, mine), continuum, r, dt);
+        solid::accelerations(&mine.passes, solid, own(couplings, mine), continuum, r, (kernel, dt));
     }
 
     /// IPST's shifting (eqs. 37-41) over its own particles, if the scheme shifts with it.
