@@ -39,6 +39,7 @@
 //! inside the plate
 //! at the end. `timeseries.csv`: `t, midspan_y, max_speed`.
 
+use super::clamped_beam_udl::midspan_shear_deflection;
 use super::fluid_scheme::{free_surface_params, scheme_params};
 use super::fsi_common::{
     check_lattice, fluid_inside, fluid_outside, fsi_setup, lattice_words, structure_params, FsiSetup,
@@ -46,15 +47,14 @@ use super::fsi_common::{
 use super::geometry::lattice;
 use super::params::{Bound, Params, Spec};
 use super::snapshots::{snapshot_bodies, surface_fields};
-use super::clamped_beam_udl::midspan_shear_deflection;
 use super::solid_common::{Probe, SolidDefaults};
-use crate::solver::systems::SolidMaterial;
 use super::stepping::{checkpoint, forward_to_sim, plan};
 use super::tank::{Column, LAYERS, RHO0};
 use super::walls::wall_params;
 use super::{common_params, SceneEntry, SceneRun};
 use crate::solver::nnps::Domain;
 use crate::solver::simulation::Simulation;
+use crate::solver::systems::SolidMaterial;
 use std::collections::BTreeMap;
 use std::path::Path;
 

@@ -791,7 +791,11 @@ source = "A marker's size."
         let r = regenerate(&p, &output, &manuscript).unwrap();
         let v: Vec<&Judgement> = r.verdicts.iter().map(|v| &v.own).collect();
         assert_eq!((v[1].verdict, v[3].verdict), (Verdict::NotReproduced, Verdict::Reproduced), "{v:?}");
-        assert!(v[1].detail.contains("16 x 16: 0.100 before it diverged at t = 0.190 s (NaN)"), "{}", v[1].detail);
+        assert!(
+            v[1].detail.contains("16 x 16: 0.100 before it diverged at t = 0.190 s (NaN)"),
+            "{}",
+            v[1].detail
+        );
     }
 
     /// A finished case with snapshots at t = 0, 0.5004 and 1.0 (pressure 0, 1, 2 and a

@@ -54,7 +54,12 @@ pub fn adjust_shift<const D: usize>(shift: Vector<D>, surface: bool, near: bool,
 /// when it points out of the body (`shift . n > 0`, the normal pointing outwards), so that
 /// a shift into the body is kept whole.
 #[inline(always)]
-pub fn adjust_shift_outward<const D: usize>(shift: Vector<D>, surface: bool, near: bool, n: &Vector<D>) -> Vector<D> {
+pub fn adjust_shift_outward<const D: usize>(
+    shift: Vector<D>,
+    surface: bool,
+    near: bool,
+    n: &Vector<D>,
+) -> Vector<D> {
     let out = shift.dot(n);
     if surface {
         Vector::zeros()

@@ -220,7 +220,9 @@ pub fn accelerations<const D: usize>(
         let mut sums = AccelSums { acc: Vector::zeros(), ac: Vector::zeros() };
         match correction.get(i) {
             None => {
-                nl.for_each(i, x, |j, xij, r2, kw| terms.neighbour(&mut sums, a, &pts[j], &kw.pair(xij, r2, h)));
+                nl.for_each(i, x, |j, xij, r2, kw| {
+                    terms.neighbour(&mut sums, a, &pts[j], &kw.pair(xij, r2, h))
+                });
                 for other in continuum.iter() {
                     other.list.for_each_from(i, x[i], other.x, |j, xij, r2, kw| {
                         across.neighbour(&mut sums, a, &other.points[j], &kw.pair(xij, r2, h))
@@ -229,7 +231,12 @@ pub fn accelerations<const D: usize>(
             }
             Some(l_a) => {
                 nl.for_each(i, x, |j, xij, r2, kw| {
-                    terms.neighbour_corrected(&mut sums, (a, l_a), (&pts[j], &correction[j]), &kw.pair(xij, r2, h))
+                    terms.neighbour_corrected(
+                        &mut sums,
+                        (a, l_a),
+                        (&pts[j], &correction[j]),
+                        &kw.pair(xij, r2, h),
+                    )
                 });
                 for other in continuum.iter() {
                     other.list.for_each_from(i, x[i], other.x, |j, xij, r2, kw| {
@@ -299,17 +306,17 @@ pub fn homogenise<const D: usize>(
 
 #[cfg(test)]
 mod tests {
-    use crate::solver::equations::solid::j2;
-    use crate::solver::interactions::UniformLoad;
-    use crate::solver::kernel::{Kernel, KernelKind};
-    use crate::solver::math::Vector;
-    use crate::solver::nnps::Domain;
     use super::{kernel_correction, rate_sums, SolidPasses};
+    use crate::solver::equations::solid::j2;
     use crate::solver::interactions::lists::{build_kernel_list, KernelList};
     use crate::solver::interactions::solid_continuum::Continuum;
     use crate::solver::interactions::solid_solid::RateTerms;
+    use crate::solver::interactions::UniformLoad;
+    use crate::solver::kernel::{Kernel, KernelKind};
     use crate::solver::math::Matrix;
+    use crate::solver::math::Vector;
     use crate::solver::nnps::CellList;
+    use crate::solver::nnps::Domain;
     use crate::solver::scheme::{Pst, SolidGradient, SolidSchemeName, SolidSettings};
     use crate::solver::simulation::Simulation;
     use crate::solver::systems::{ElasticSolid, SolidInit, SolidMaterial};
@@ -338,7 +345,13 @@ mod tests {
         solid_with(init, dx, pst, alpha, SolidGradient::Paper)
     }
 
-    fn solid_with(init: SolidInit<2>, dx: f64, pst: Pst, alpha: f64, gradient: SolidGradient) -> ElasticSolid<2> {
+    fn solid_with(
+        init: SolidInit<2>,
+        dx: f64,
+        pst: Pst,
+        alpha: f64,
+        gradient: SolidGradient,
+    ) -> ElasticSolid<2> {
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
         let settings = SolidSettings {
             pst,
@@ -528,7 +541,9 @@ mod tests {
         let dx = 0.01;
         let grad = Matrix::<2>::new(0.3, -1.1, 0.7, 0.2);
         let v = |x: Vector<2>| grad * x + Vector::<2>::new(0.5, -0.25);
-        for (gradient, hdx) in [(SolidGradient::Corrected, 1.0), (SolidGradient::Corrected, 1.3), (SolidGradient::Paper, 1.0)] {
+        for (gradient, hdx) in
+            [(SolidGradient::Corrected, 1.0), (SolidGradient::Corrected, 1.3), (SolidGradient::Paper, 1.0)]
+        {
             let mut body = solid_with(block(20, 6, dx, v), dx, Pst::None, 1.0, gradient);
             body.h = hdx * dx;
             let worst = gradients(&body).iter().map(|g| (g - grad).norm() / grad.norm()).fold(0.0, f64::max);
@@ -576,11 +591,18 @@ mod tests {
                         }
                     }
                     let want = kappa * (y + num / den);
-                    assert!((g[top][(0, 0)] - want).abs() < 1e-9 * want.abs(), "{ny}: {} against {want}", g[top][(0, 0)]);
+                    assert!(
+                        (g[top][(0, 0)] - want).abs() < 1e-9 * want.abs(),
+                        "{ny}: {} against {want}",
+                        g[top][(0, 0)]
+                    );
                 }
             }
             // The measured ratios, to the four digits quoted.
-            assert!((ratios[0] - paper).abs() < 1e-4 && (ratios[1] - corrected).abs() < 1e-4, "{ny}: {ratios:?}");
+            assert!(
+                (ratios[0] - paper).abs() < 1e-4 && (ratios[1] - corrected).abs() < 1e-4,
+                "{ny}: {ratios:?}"
+            );
         }
     }
 

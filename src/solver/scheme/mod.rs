@@ -13,7 +13,10 @@ pub mod settings;
 pub mod solid;
 
 pub use settings::{FluidSettings, OptionError, SchemeOptions};
-pub use solid::{GradientVelocity, GtvfBackground, SolidGradient, SurfaceShift, SolidScheme, SolidSchemeName, SolidSettings, SolidShifting};
+pub use solid::{
+    GradientVelocity, GtvfBackground, SolidGradient, SolidScheme, SolidSchemeName, SolidSettings,
+    SolidShifting, SurfaceShift,
+};
 
 use serde::{Deserialize, Serialize};
 use std::fmt;

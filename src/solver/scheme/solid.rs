@@ -218,7 +218,10 @@ impl SolidSchemeName {
             ));
         }
         if self == SolidSchemeName::Gtvf && !(s.p_ref > 0.0 && s.p_ref.is_finite()) {
-            return Err(format!("GTVF's background pressure cap p_ref = {:?} Pa must be positive and finite", s.p_ref));
+            return Err(format!(
+                "GTVF's background pressure cap p_ref = {:?} Pa must be positive and finite",
+                s.p_ref
+            ));
         }
         let shifting =
             (s.pst == Pst::Sun).then_some(SolidShifting { ma_c0: s.u_ref, w_dx: s.w_dx, r: 0.2, n: 4 });
@@ -360,14 +363,18 @@ mod tests {
         assert!(g.transports() && !g.free_surface && g.shifting.is_none() && g.ipst.is_none());
         let e = SolidSchemeName::Gtvf.solid_scheme(&settings(Pst::Sun)).unwrap_err();
         assert!(e.contains("`scheme` = gtvf") && e.contains("`pst` = sun"), "{e}");
-        let e = SolidSchemeName::Gtvf.solid_scheme(&SolidSettings { p_ref: 0.0, ..settings(Pst::None) }).unwrap_err();
+        let e = SolidSchemeName::Gtvf
+            .solid_scheme(&SolidSettings { p_ref: 0.0, ..settings(Pst::None) })
+            .unwrap_err();
         assert!(e.contains("p_ref = 0.0"), "{e}");
         let ipst = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::Ipst)).unwrap();
         assert!(ipst.shifting.is_none() && ipst.ipst.is_some() && ipst.transports() && ipst.corrections);
         let gray = SolidSchemeName::Gray.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(gray.shifting.is_none() && !gray.corrections && gray.artificial_stress.is_some());
         assert!(SolidSchemeName::Gray.solid_scheme(&settings(Pst::Sun)).unwrap_err().contains("gray"));
-        assert!(c.artificial_stress.is_none() && t.artificial_stress.is_none() && g.artificial_stress.is_none());
+        assert!(
+            c.artificial_stress.is_none() && t.artificial_stress.is_none() && g.artificial_stress.is_none()
+        );
         let still = SolidSchemeName::Ctvf.solid_scheme(&settings(Pst::None)).unwrap();
         assert!(still.shifting.is_none() && !still.corrections, "no transport velocity: nothing to correct");
     }

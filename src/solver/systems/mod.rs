@@ -23,7 +23,7 @@ pub mod fluid;
 pub mod wall;
 
 pub use boundary::{BoundaryMaterial, BoundaryModel, Presented, WallDensity, WallPressure, WallViscosity};
-pub use elastic_solid::{ElasticSolid, SolidInit, SolidMaterial, SolidRates, SolidWork};
+pub use elastic_solid::{ElasticSolid, MirrorPlane, SolidInit, SolidMaterial, SolidRates, SolidWork};
 pub use fluid::{Fluid, FluidInit, FluidPart, FluidRates, FluidWork};
 pub use wall::{Wall, WallMotion};
 

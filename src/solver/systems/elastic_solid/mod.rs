@@ -13,12 +13,19 @@
 //! plate (sec. 4.4, fig. 17) follows; it needs no extrapolation of the stress onto a
 //! separate boundary (eq. 53).
 //!
+//! **Frictionless platens.** A plane the body slides on without friction is made of fixed
+//! particles that mirror the body's particles across it ([`MirrorPlane`], set by
+//! [`ElasticSolid::with_mirror`]): after every drift and closing kick each ghost takes its
+//! partner's state reflected.
+//!
 //! **Plasticity.** A material with a yield stress Y0 is elastic-perfectly plastic
 //! (sec. 4.7): after every stress update the deviatoric stress is returned radially onto
 //! the von Mises surface ([`radial_return`]).
 
+mod mirror;
 mod stages;
 
+pub use mirror::{mirror_point, mirror_tensor, mirror_velocity, MirrorPlane};
 pub use stages::{SolidStages, SolidWork};
 
 use super::boundary::{BoundaryMaterial, BoundaryModel};
@@ -150,6 +157,9 @@ pub struct ElasticSolid<const D: usize> {
     /// (thesis sec. 4.2.4, eq. 4.14); `None` for a solid no fluid sees.
     #[serde(default)]
     pub boundary: Option<BoundaryModel<D>>,
+    /// Planes the body slides on without friction, their ghosts mirroring the body.
+    #[serde(default)]
+    pub mirrors: Vec<MirrorPlane>,
 }
 
 /// Time derivatives of a solid body, owned by the simulation.
@@ -231,7 +241,37 @@ impl<const D: usize> ElasticSolid<D> {
             s: vec![Matrix::zeros(); n],
             fixed: init.fixed,
             boundary: None,
+            mirrors: Vec::new(),
         })
+    }
+
+    /// The body with a frictionless plane whose ghosts (fixed particles) mirror their
+    /// partners (free ones); the ghosts take their partners' state at once. Errors name the
+    /// body and the offending pair.
+    pub fn with_mirror(mut self, plane: MirrorPlane) -> Result<Self, String> {
+        plane.check(self.len(), &self.fixed).map_err(|e| format!("solid `{}`: {e}", self.name))?;
+        self.mirrors.push(plane);
+        self.apply_mirrors();
+        Ok(self)
+    }
+
+    /// Every ghost of every mirror plane takes its partner's position, velocities, density,
+    /// pressure and deviatoric stress, reflected across the plane.
+    fn apply_mirrors(&mut self) {
+        for plane in &self.mirrors {
+            let (axis, at, v) = (plane.axis, plane.position, plane.velocity);
+            for &(g, p) in &plane.pairs {
+                let (g, p) = (g as usize, p as usize);
+                self.x[g] = mirror_point(self.x[p], axis, at);
+                self.u[g] = mirror_velocity(self.u[p], axis, v);
+                if let Some(uh) = self.u_hat.as_mut() {
+                    uh[g] = self.u[g];
+                }
+                self.rho[g] = self.rho[p];
+                self.p[g] = self.p[p];
+                self.s[g] = mirror_tensor(&self.s[p], axis);
+            }
+        }
     }
 
     /// The solid as a structure a fluid meets (thesis sec. 4.2.4): its particles present
@@ -258,8 +298,11 @@ impl<const D: usize> ElasticSolid<D> {
     /// reads (its boundary values are sized once).
     pub fn retain(&mut self, keep: &[bool]) -> Result<(), String> {
         use super::retain_by;
-        if self.boundary.is_some() {
-            return Err(format!("solid `{}`: a structure a fluid reads keeps its particles", self.name));
+        if self.boundary.is_some() || !self.mirrors.is_empty() {
+            return Err(format!(
+                "solid `{}`: a structure a fluid reads, or a body with mirror planes, keeps its particles",
+                self.name
+            ));
         }
         retain_by(&mut self.x, keep);
         retain_by(&mut self.u, keep);
@@ -277,8 +320,11 @@ impl<const D: usize> ElasticSolid<D> {
     /// Appends the particles of `more`, a solid of the same material, scheme and smoothing
     /// length (as built). Errors as [`retain`](Self::retain), and for another material.
     pub fn extend(&mut self, more: ElasticSolid<D>) -> Result<(), String> {
-        if self.boundary.is_some() {
-            return Err(format!("solid `{}`: a structure a fluid reads keeps its particles", self.name));
+        if self.boundary.is_some() || !self.mirrors.is_empty() {
+            return Err(format!(
+                "solid `{}`: a structure a fluid reads, or a body with mirror planes, keeps its particles",
+                self.name
+            ));
         }
         if more.material != self.material || more.h != self.h || more.physics.name != self.physics.name {
             return Err(format!(
@@ -343,14 +389,22 @@ impl<const D: usize> ElasticSolid<D> {
         }
     }
 
-    /// The drift of eq. (59), with the transport velocity if there is one.
+    /// The drift of eq. (59), with the transport velocity if there is one; mirror planes
+    /// move with it and their ghosts follow their partners.
     pub fn drift(&mut self, dt: f64) {
         integrator::drift(&mut self.x, self.u_hat.as_deref().unwrap_or(&self.u), dt);
+        if !self.mirrors.is_empty() {
+            self.mirrors.iter_mut().for_each(|m| m.advance(dt));
+            self.apply_mirrors();
+        }
     }
 
-    /// The closing half kick (eq. 60).
+    /// The closing half kick (eq. 60); the ghosts of mirror planes follow their partners.
     pub fn kick_close(&mut self, r: &SolidRates<D>, dt: f64) {
         integrator::kick(&mut self.u, &r.du, dt);
+        if !self.mirrors.is_empty() {
+            self.apply_mirrors();
+        }
     }
 }
 
