@@ -17,7 +17,7 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("scheme", "edac") => "EDAC".into(),
         ("scheme", "tvf") => "TVF".into(),
         ("scheme", "ctvf") => "CTVF".into(),
-        ("scheme", "gtvf") => "GTVF".into(),
+        ("scheme", "gtvf") => "GTVF (its background pressure)".into(),
         ("scheme", "gtvf_pst") => "GTVF's equations".into(),
         ("scheme", "gray") => "Gray et al. (artificial stress)".into(),
         ("pst", "sun") => "SPST".into(),
@@ -92,10 +92,17 @@ fn number_value(v: &Value) -> Option<f64> {
 }
 
 /// The `keys` parameters of `case` in words, joined by commas (its name if none, or if every
-/// phrase is empty).
+/// phrase is empty). A solid's `gtvf` homogenises by its own background pressure and has no
+/// correction terms, so its `pst` and `corrections` (which it refuses but `none`) go unsaid:
+/// "no shifting" would misread it.
 pub(crate) fn label(case: &Case, keys: &[String]) -> String {
+    let gtvf = |k: &str| {
+        let key = if k.starts_with("solid_") { "solid_scheme" } else { "scheme" };
+        matches!(case.params.0.get(key), Some(Value::Str(s)) if s == "gtvf")
+    };
     let words: Vec<String> = keys
         .iter()
+        .filter(|k| !(gtvf(k) && matches!(k.trim_start_matches("solid_"), "pst" | "corrections")))
         .filter_map(|k| case.params.0.get(k).map(|v| phrase(k, v)))
         .filter(|p| !p.is_empty())
         .collect();
@@ -122,5 +129,26 @@ mod tests {
         assert_eq!(phrase("frobs", &Value::Int(3)), "frobs = 3");
         assert_eq!(value(&Value::Float(1e9)), "1e9");
         assert_eq!(value(&Value::Int(1_000_000)), "1e6");
+    }
+
+    /// GTVF's legend names its own homogenisation, not "no shifting"; Gray's keeps it.
+    #[test]
+    fn gtvf_is_not_said_to_shift_nothing() {
+        let case = |scheme: &str| Case {
+            name: "c".into(),
+            scene: "oscillating_plate".into(),
+            params: crate::scenes::params::Params(
+                [("scheme", scheme), ("pst", "none"), ("corrections", "none")]
+                    .into_iter()
+                    .map(|(k, v)| (k.to_string(), Value::Str(v.into())))
+                    .collect(),
+            ),
+        };
+        let keys: Vec<String> = ["scheme", "pst", "corrections"].map(String::from).to_vec();
+        assert_eq!(label(&case("gtvf"), &keys), "GTVF (its background pressure)");
+        assert_eq!(
+            label(&case("gray"), &keys),
+            "Gray et al. (artificial stress), no shifting, without corrections"
+        );
     }
 }
