@@ -4,6 +4,7 @@
 
 use crate::automation::registry::Case;
 use crate::scenes::params::Value;
+use crate::solver::scheme::SolidSchemeName;
 
 /// The words for parameter `key` at value `v`; empty when the value needs no mention (a
 /// switch left to the scheme's default).
@@ -92,17 +93,24 @@ fn number_value(v: &Value) -> Option<f64> {
 }
 
 /// The `keys` parameters of `case` in words, joined by commas (its name if none, or if every
-/// phrase is empty). A solid's `gtvf` homogenises by its own background pressure and has no
-/// correction terms, so its `pst` and `corrections` (which it refuses but `none`) go unsaid:
-/// "no shifting" would misread it.
+/// phrase is empty). A key its solid scheme fixes ([`SolidSchemeName::fixed_keys`]; a
+/// structure's `solid_` keys by its `solid_scheme`) goes unsaid.
 pub(crate) fn label(case: &Case, keys: &[String]) -> String {
-    let gtvf = |k: &str| {
-        let key = if k.starts_with("solid_") { "solid_scheme" } else { "scheme" };
-        matches!(case.params.0.get(key), Some(Value::Str(s)) if s == "gtvf")
+    let fixed = |k: &str| {
+        let (scheme_key, bare) = match k.strip_prefix("solid_") {
+            Some(bare) => ("solid_scheme", bare),
+            None => ("scheme", k),
+        };
+        match case.params.0.get(scheme_key) {
+            Some(Value::Str(s)) => {
+                SolidSchemeName::from_name(s).is_some_and(|n| n.fixed_keys().contains(&bare))
+            }
+            _ => false,
+        }
     };
     let words: Vec<String> = keys
         .iter()
-        .filter(|k| !(gtvf(k) && matches!(k.trim_start_matches("solid_"), "pst" | "corrections")))
+        .filter(|k| !fixed(k))
         .filter_map(|k| case.params.0.get(k).map(|v| phrase(k, v)))
         .filter(|p| !p.is_empty())
         .collect();

@@ -353,17 +353,7 @@ mod tests {
         gradient: SolidGradient,
     ) -> ElasticSolid<2> {
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
-        let settings = SolidSettings {
-            pst,
-            corrections: true,
-            alpha,
-            u_ref: 1.0,
-            w_dx: kernel.w(dx, dx),
-            gravity: [0.0; 3],
-            gradient,
-            p_ref: 1.0,
-            surface_shift: Default::default(),
-        };
+        let settings = SolidSettings { alpha, gradient, ..SolidSettings::for_tests(pst, kernel.w(dx, dx)) };
         let scheme = SolidSchemeName::Ctvf.solid_scheme(&settings).unwrap();
         ElasticSolid::new("block", dx, init, material(), scheme).unwrap()
     }
@@ -483,15 +473,10 @@ mod tests {
         let (n, dx) = (12, 0.01);
         let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
         let settings = |p_ref| SolidSettings {
-            pst: Pst::None,
             corrections: false,
             alpha: 0.0,
-            u_ref: 1.0,
-            w_dx: kernel.w(dx, dx),
-            gravity: [0.0; 3],
-            gradient: SolidGradient::Paper,
             p_ref,
-            surface_shift: Default::default(),
+            ..SolidSettings::for_tests(Pst::None, kernel.w(dx, dx))
         };
         let centre = 6 * n + 6;
         let far = 6 * n + 3;

@@ -36,6 +36,19 @@ named_choices!(SolidSchemeName {
     Gray => "gray",
 });
 
+impl SolidSchemeName {
+    /// The parameters this scheme fixes itself (it refuses any other value), whose value a
+    /// legend would misread as a choice: GTVF homogenises by its own background pressure
+    /// and has no correction terms, so its `pst` = none is not "no shifting". Gray's are kept:
+    /// its particles are indeed not shifted and uncorrected.
+    pub fn fixed_keys(self) -> &'static [&'static str] {
+        match self {
+            SolidSchemeName::Gtvf => &["pst", "corrections"],
+            _ => &[],
+        }
+    }
+}
+
 /// Monaghan's artificial stress (Gray et al. 2001, eqs. 4.7-4.10): `eps`, the exponent `n`
 /// of `f_ab = W_ab / W(dx)`, and W(dx).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -199,6 +212,26 @@ pub struct SolidSettings {
     pub surface_shift: SurfaceShift,
 }
 
+#[cfg(test)]
+impl SolidSettings {
+    /// The settings the solid tests share: CTVF's corrections, alpha = 1, unit reference
+    /// speed and GTVF cap, no gravity, the paper's kernel gradient; each test changes what
+    /// it studies by struct update.
+    pub fn for_tests(pst: Pst, w_dx: f64) -> Self {
+        SolidSettings {
+            pst,
+            corrections: true,
+            alpha: 1.0,
+            u_ref: 1.0,
+            w_dx,
+            gravity: [0.0; 3],
+            gradient: SolidGradient::Paper,
+            p_ref: 1.0,
+            surface_shift: SurfaceShift::Normal,
+        }
+    }
+}
+
 impl SolidSchemeName {
     /// The composition this name stands for. `gray` has no transport velocity and `gtvf`
     /// homogenises with its own background pressure, so both take `pst` = none only. IPST
@@ -327,17 +360,7 @@ mod tests {
     use super::*;
 
     fn settings(pst: Pst) -> SolidSettings {
-        SolidSettings {
-            pst,
-            corrections: true,
-            alpha: 1.0,
-            u_ref: 1.0,
-            w_dx: 1.0,
-            gravity: [0.0; 3],
-            gradient: SolidGradient::Paper,
-            p_ref: 2.0,
-            surface_shift: SurfaceShift::Normal,
-        }
+        SolidSettings { p_ref: 2.0, ..SolidSettings::for_tests(pst, 1.0) }
     }
 
     /// `ctvf` and `gtvf_pst` differ in the gradient's velocity and the corrections only; `gtvf`

@@ -363,17 +363,7 @@ fn momentum_crosses_the_fluid_structure_interface_without_loss() {
             ..FluidSettings::internal_flow(1.0, 10.0, 1.0, dx, kernel.w(dx, dx), 0.01)
         };
         let fluid = Fluid::new("water", dx, fluid, SchemeName::Ctvf.fluid_scheme(&settings)).unwrap();
-        let solid_settings = SolidSettings {
-            pst: Pst::Sun,
-            corrections: true,
-            alpha: 1.0,
-            u_ref: 1.0,
-            w_dx: kernel.w(dx, dx),
-            gravity: [0.0; 3],
-            gradient: SolidGradient::Paper,
-            p_ref: 1.0,
-            surface_shift: Default::default(),
-        };
+        let solid_settings = SolidSettings::for_tests(Pst::Sun, kernel.w(dx, dx));
         let material = SolidMaterial::new(300.0, 0.3, 1.0).unwrap();
         let boundary = BoundaryMaterial {
             rho0: 1.0,
@@ -548,17 +538,7 @@ fn a_solid_losing_and_gaining_a_lone_particle_leaves_the_rest_bit_for_bit() {
     let dx = 0.01;
     let kernel = Kernel::new(KernelKind::QuinticSpline, 2);
     let material = SolidMaterial::new(2.0e6, 0.3975, 1000.0).unwrap();
-    let settings = SolidSettings {
-        pst: Pst::None,
-        corrections: true,
-        alpha: 1.0,
-        u_ref: 1.0,
-        w_dx: kernel.w(dx, dx),
-        gravity: [0.0; 3],
-        gradient: SolidGradient::Paper,
-        p_ref: 1.0,
-        surface_shift: Default::default(),
-    };
+    let settings = SolidSettings::for_tests(Pst::None, kernel.w(dx, dx));
     let physics = SolidSchemeName::Ctvf.solid_scheme(&settings).unwrap();
     let block = |lone: bool| {
         let mut init = SolidInit::<2>::default();

@@ -414,18 +414,7 @@ mod tests {
     use crate::solver::scheme::{Pst, SolidGradient, SolidSchemeName, SolidSettings};
 
     fn physics() -> SolidScheme {
-        let s = SolidSettings {
-            pst: Pst::Sun,
-            corrections: true,
-            alpha: 1.0,
-            u_ref: 1.0,
-            w_dx: 1.0,
-            gravity: [0.0; 3],
-            gradient: SolidGradient::Paper,
-            p_ref: 1.0,
-            surface_shift: Default::default(),
-        };
-        SolidSchemeName::Ctvf.solid_scheme(&s).unwrap()
+        SolidSchemeName::Ctvf.solid_scheme(&SolidSettings::for_tests(Pst::Sun, 1.0)).unwrap()
     }
 
     /// The oscillating plate's material (CTVF sec. 4.4): c0 = sqrt(E / (3 (1 - 2 nu) rho0)).
