@@ -391,6 +391,15 @@ impl<const D: usize, P: Copy + Default + Send + Sync> NeighbourList<D, P> {
         }
     }
 
+    /// Whether `f(j)` holds for any neighbour `j` of point `i` (itself included), stopping
+    /// at the first that does: a test of the neighbours' indices alone, which reads neither
+    /// positions nor payloads.
+    #[inline(always)]
+    pub fn any<F: FnMut(usize) -> bool>(&self, i: usize, mut f: F) -> bool {
+        let (chunk, range) = self.range(i);
+        chunk.entries[range].iter().any(|&e| f((e & J_MASK) as usize))
+    }
+
     /// The chunk holding point `i` and the range of its entries in it. The chunk alone is
     /// borrowed, not the array of all (which a [`ChunkWriter`] may be filling elsewhere).
     #[inline(always)]

@@ -113,17 +113,20 @@ impl<const D: usize> SurfaceFields<D> {
             let mut covered = false;
             match cone {
                 SurfaceCone::Support => {
-                    nl.for_each(i, x, |_, xij, r2, kw| covered |= in_normal_cone(&na, &kw.pair(xij, r2, h)));
+                    // One neighbour in the cone settles it: the rest are not tested.
+                    nl.for_each(i, x, |_, xij, r2, kw| {
+                        covered = covered || in_normal_cone(&na, &kw.pair(xij, r2, h))
+                    });
                     for b in boundaries.iter() {
                         b.list.for_each_from(i, x[i], b.x, |_, xij, r2, kw| {
-                            covered |= in_normal_cone(&na, &kw.pair(xij, r2, h))
+                            covered = covered || in_normal_cone(&na, &kw.pair(xij, r2, h))
                         });
                     }
                 }
                 SurfaceCone::Fluid2h => {
                     let reach2 = 4.0 * h * h;
                     nl.for_each(i, x, |_, xij, r2, kw| {
-                        covered |= r2 < reach2 && in_normal_cone(&na, &kw.pair(xij, r2, h))
+                        covered = covered || (r2 < reach2 && in_normal_cone(&na, &kw.pair(xij, r2, h)))
                     });
                 }
             }
@@ -132,11 +135,7 @@ impl<const D: usize> SurfaceFields<D> {
         // Algorithm 1: the particles with a surface particle in their support.
         let surface = &self.surface;
         self.near.par_iter_mut().enumerate().for_each(|(i, out)| {
-            let mut near = false;
-            if !surface[i] {
-                nl.for_each(i, x, |j, _, _, _| near |= surface[j]);
-            }
-            *out = near;
+            *out = !surface[i] && nl.any(i, |j| surface[j]);
         });
     }
 
