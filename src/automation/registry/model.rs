@@ -271,8 +271,9 @@ pub enum Test {
         /// Falls (`true`) or grows.
         decreasing: bool,
     },
-    /// The mean of `metric` over the `lower` cases is at most `factor` times its mean over
-    /// the `higher` ones (both within the claim's selection).
+    /// In every group of the claim's cases alike but in the parameters `lower` and `higher`
+    /// select by (each resolution of a study on its own), the mean of `metric` over the
+    /// group's `lower` cases is at most `factor` times its mean over its `higher` ones.
     LowerThan {
         /// Metric.
         metric: String,

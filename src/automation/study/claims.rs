@@ -1,7 +1,9 @@
 //! Verdicts on the paper's claims: each claim of a problem file is a test on the summaries'
 //! metrics at a preset ([`Test`]); its verdict is `reproduced`, `not reproduced` (with each
 //! case's number against the test) or `not run` (results missing at that preset, with an
-//! estimate of what they would cost). When the claim's own preset has no results and another
+//! estimate of what they would cost). A case that ran and fails the test on its own (it
+//! diverged, or breaks the bound) makes the claim `not reproduced` even while others are
+//! missing: a failure at the claim's resolution is never hidden as `not run`. When the claim's own preset has no results and another
 //! preset does, the verdict there is given too, labelled as drawn at that resolution.
 
 use super::words;
@@ -148,7 +150,7 @@ fn describe(claim: &Claim, preset: &str) -> String {
             };
             let times = if *factor == 1.0 { String::new() } else { format!("{factor} x ") };
             format!(
-                "`{metric}` ({}) <= {times}`{metric}` ({}), each the mean over its cases",
+                "`{metric}` ({}) <= {times}`{metric}` ({}) in every group of cases alike in the other parameters (each resolution on its own), a side's cases averaged within a group",
                 side(lower),
                 side(higher)
             )
@@ -178,6 +180,32 @@ fn outcome(entry: &Entry, metric: &str) -> Outcome {
             s.metrics.get(metric).copied().map(Outcome::Value).unwrap_or(Outcome::NoMetric)
         }
         _ => Outcome::Missing,
+    }
+}
+
+/// How a value breaks the bound `[min, max]`: " > max", " < min", or nothing.
+fn mark(max: Option<f64>, min: Option<f64>, x: f64) -> String {
+    // NaN is over and under: a non-finite value passes no bound.
+    match (max, min) {
+        (Some(m), _) if x.is_nan() || x > m => format!(" > {}", fmt_bound(m)),
+        (_, Some(m)) if x.is_nan() || x < m => format!(" < {}", fmt_bound(m)),
+        _ => String::new(),
+    }
+}
+
+/// Whether a case's outcome fails `test` on its own, whatever the other cases give: a run
+/// that blew up (unless the running record it kept passes a lower bound, which it cannot
+/// fall back from) or has not the metric fails any test; a value fails a bound it breaks.
+fn fails_alone(test: &Test, v: &Outcome) -> bool {
+    match (test, v) {
+        (_, Outcome::Missing) => false,
+        (_, Outcome::NoMetric) => true,
+        (Test::Bound { max, min, .. }, Outcome::Value(x)) => {
+            max.is_some_and(|m| x.is_nan() || *x > m) || min.is_some_and(|m| x.is_nan() || *x < m)
+        }
+        (_, Outcome::Value(_)) => false,
+        (Test::Bound { max: None, min: Some(m), .. }, Outcome::Diverged(_, _, Some(x))) => *x < *m,
+        (_, Outcome::Diverged(..)) => true,
     }
 }
 
@@ -234,19 +262,6 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
         picked.iter().map(|c| (*c, outcome(&Entry::new(output, p, c), metric))).collect();
     let missing: Vec<&Case> =
         results.iter().filter(|(_, v)| matches!(v, Outcome::Missing)).map(|(c, _)| *c).collect();
-    if !missing.is_empty() {
-        let list: Vec<String> = missing
-            .iter()
-            .map(|c| {
-                let est = estimate(p, c, output).map(|e| format!(" ({e})")).unwrap_or_default();
-                format!("`{}`{est}", c.name)
-            })
-            .collect();
-        return j(
-            Verdict::NotRun,
-            format!("no result for {} of the {} case(s): {}.", missing.len(), picked.len(), list.join("; ")),
-        );
-    }
     let show = |c: &Case, v: &Outcome| match v {
         Outcome::Value(x) => format!("{}: {}", name(c), fmt_value(*x)),
         Outcome::Diverged(t, why, None) => format!("{}: diverged at t = {t:.3} s ({why})", name(c)),
@@ -256,6 +271,33 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
         Outcome::NoMetric => format!("{}: no `{metric}`", name(c)),
         Outcome::Missing => format!("{}: no result", name(c)),
     };
+    if !missing.is_empty() {
+        let list: Vec<String> = missing
+            .iter()
+            .map(|c| {
+                let est = estimate(p, c, output).map(|e| format!(" ({e})")).unwrap_or_default();
+                format!("`{}`{est}", c.name)
+            })
+            .collect();
+        let not_run =
+            format!("no result for {} of the {} case(s): {}.", missing.len(), picked.len(), list.join("; "));
+        // A case that has run and fails the test decides the claim whatever the missing
+        // ones would give: every test needs each of its cases to hold.
+        let failed: Vec<String> = results
+            .iter()
+            .filter(|(_, v)| fails_alone(&ct.test, v))
+            .map(|(c, v)| match (&ct.test, v) {
+                (Test::Bound { max, min, .. }, Outcome::Value(x)) => {
+                    format!("{}{}", show(c, v), mark(*max, *min, *x))
+                }
+                _ => show(c, v),
+            })
+            .collect();
+        if failed.is_empty() {
+            return j(Verdict::NotRun, not_run);
+        }
+        return j(Verdict::NotReproduced, format!("`{metric}` {}; and {not_run}", failed.join("; ")));
+    }
     match &ct.test {
         Test::Bound { max, min, .. } => {
             let mut ok = true;
@@ -263,18 +305,8 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
                 .iter()
                 .map(|(c, v)| match v {
                     Outcome::Value(x) => {
-                        // NaN is over and under: a non-finite value passes no bound.
-                        let over = max.is_some_and(|m| x.is_nan() || *x > m);
-                        let under = min.is_some_and(|m| x.is_nan() || *x < m);
-                        ok &= !(over || under);
-                        let mark = if over {
-                            format!(" > {}", fmt_bound(max.unwrap()))
-                        } else if under {
-                            format!(" < {}", fmt_bound(min.unwrap()))
-                        } else {
-                            String::new()
-                        };
-                        format!("{}{mark}", show(c, v))
+                        ok &= !fails_alone(&ct.test, v);
+                        format!("{}{}", show(c, v), mark(*max, *min, *x))
                     }
                     // A running record over a lower bound only: it passed before the blow-up
                     // and cannot fall back.
@@ -350,22 +382,41 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
             )
         }
         Test::LowerThan { lower, higher, factor, .. } => {
-            let side = |s: &Select| -> (Option<f64>, Vec<String>, bool) {
-                let mut vals = Vec::new();
-                let mut notes = Vec::new();
-                let mut bad = false;
-                for (c, v) in results.iter().filter(|(c, _)| s.matches(c)) {
-                    match v {
-                        Outcome::Value(x) => vals.push(*x),
-                        other => {
-                            bad = true;
-                            notes.push(show(c, other));
-                        }
-                    }
-                }
-                let mean = (!vals.is_empty() && !bad).then(|| vals.iter().sum::<f64>() / vals.len() as f64);
-                (mean, notes, bad || vals.is_empty())
+            // The comparison holds in every group of cases alike but in the parameters the
+            // two sides are told apart by (each resolution of a study on its own), not on a
+            // mean that one group can carry.
+            // The sides' parameters: those the two sides hold no value of in common (the
+            // `where` keys, or what tells cases picked by name apart).
+            let values = |s: &Select, k: &String| -> Vec<String> {
+                results
+                    .iter()
+                    .filter(|(c, _)| s.matches(c))
+                    .map(|(c, _)| format!("{:?}", c.params.0.get(k)))
+                    .collect()
             };
+            let all_keys: std::collections::BTreeSet<&String> =
+                results.iter().flat_map(|(c, _)| c.params.0.keys()).collect();
+            let sides: Vec<&String> = all_keys
+                .into_iter()
+                .filter(|k| {
+                    let (a, b) = (values(lower, k), values(higher, k));
+                    lower.where_.contains_key(*k)
+                        || higher.where_.contains_key(*k)
+                        || (!a.is_empty() && !b.is_empty() && a.iter().all(|v| !b.contains(v)))
+                })
+                .collect();
+            let mut groups: BTreeMap<String, Vec<&(&Case, Outcome)>> = BTreeMap::new();
+            for r in &results {
+                let key: Vec<String> =
+                    r.0.params
+                        .0
+                        .iter()
+                        .filter(|(k, _)| !sides.contains(k))
+                        .map(|(k, v)| format!("{k}={v}"))
+                        .collect();
+                groups.entry(key.join(",")).or_default().push(r);
+            }
+            let group_keys: Vec<String> = keys.iter().filter(|k| !sides.contains(k)).cloned().collect();
             let describe_side = |s: &Select| -> String {
                 let cs: Vec<&Case> = results.iter().map(|(c, _)| *c).filter(|c| s.matches(c)).collect();
                 let k: Vec<String> = s.where_.keys().cloned().collect();
@@ -374,29 +425,58 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
                     _ => cs.iter().map(|c| c.name.clone()).collect::<Vec<_>>().join(", "),
                 }
             };
-            let (a, an, abad) = side(lower);
-            let (b, bn, bbad) = side(higher);
             let (la, lb) = (describe_side(lower), describe_side(higher));
-            match (a, b) {
-                (Some(a), Some(b)) if !abad && !bbad => {
-                    let ok = a <= factor * b;
-                    let ratio = if b != 0.0 { format!(" (ratio {:.2})", a / b) } else { String::new() };
-                    let bound = if *factor == 1.0 { String::new() } else { format!(" x {factor}") };
-                    j(
-                        if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
-                        format!(
-                            "`{metric}` {la}: {} {} {lb}: {}{bound}{ratio}.",
+            let bound = if *factor == 1.0 { String::new() } else { format!(" x {factor}") };
+            let mut ok = true;
+            let mut parts = Vec::new();
+            for g in groups.values() {
+                let side = |s: &Select| -> Result<f64, Vec<String>> {
+                    let mut vals = Vec::new();
+                    let mut notes = Vec::new();
+                    for (c, v) in g.iter().map(|r| (&r.0, &r.1)).filter(|(c, _)| s.matches(c)) {
+                        match v {
+                            Outcome::Value(x) => vals.push(*x),
+                            other => notes.push(show(c, other)),
+                        }
+                    }
+                    match (notes.is_empty(), vals.is_empty()) {
+                        (true, false) => Ok(vals.iter().sum::<f64>() / vals.len() as f64),
+                        _ => Err(notes),
+                    }
+                };
+                let head = if group_keys.is_empty() || groups.len() == 1 {
+                    String::new()
+                } else {
+                    format!("{}: ", words::label(g[0].0, &group_keys))
+                };
+                match (side(lower), side(higher)) {
+                    (Ok(a), Ok(b)) => {
+                        let holds = a <= factor * b;
+                        ok &= holds;
+                        let ratio = if b != 0.0 { format!(" (ratio {:.2})", a / b) } else { String::new() };
+                        parts.push(format!(
+                            "{head}{la}: {} {} {lb}: {}{bound}{ratio}",
                             fmt_value(a),
-                            if ok { "<=" } else { ">" },
+                            if holds { "<=" } else { ">" },
                             fmt_value(b)
-                        ),
-                    )
-                }
-                _ => {
-                    let notes: Vec<String> = an.into_iter().chain(bn).collect();
-                    j(Verdict::NotReproduced, format!("`{metric}` {}.", notes.join("; ")))
+                        ));
+                    }
+                    (a, b) => {
+                        ok = false;
+                        let notes: Vec<String> = a.err().into_iter().chain(b.err()).flatten().collect();
+                        let notes = if notes.is_empty() {
+                            "one side has no case".to_string()
+                        } else {
+                            notes.join("; ")
+                        };
+                        parts.push(format!("{head}{notes}"));
+                    }
                 }
             }
+            j(
+                if ok { Verdict::Reproduced } else { Verdict::NotReproduced },
+                format!("`{metric}` {}.", parts.join("; ")),
+            )
         }
     }
 }

@@ -686,6 +686,65 @@ source = "A marker's size."
         }
     }
 
+    /// A comparative claim over a study holds at each of its resolutions, not on the mean:
+    /// IPST lower than SPST on average but higher at one lattice is not reproduced, and the
+    /// verdict names the lattice; with a margin the ratio must clear it at every lattice.
+    #[test]
+    fn a_comparison_holds_at_each_resolution() {
+        let src = |factor: f64| {
+            format!(
+                r#"
+title = "t"
+scene = "taylor_green"
+paper = "ctvf"
+[presets.quick]
+nx = [12, 16]
+[[cases]]
+name = "{{pst}}-nx{{nx}}"
+params = {{ scheme = "ctvf" }}
+grid = {{ nx = "$nx", pst = ["sun", "ipst"] }}
+[[tables]]
+id = "l1"
+title = "L1"
+columns = ["nx", "pst"]
+metrics = ["l1_velocity_final"]
+caption = "L1."
+[[claims]]
+figure = "l1"
+claim = "IPST is better."
+preset = "quick"
+test = {{ metric = "l1_velocity_final", lower = {{ where = {{ pst = "ipst" }} }}, higher = {{ where = {{ pst = "sun" }} }}, factor = {factor} }}
+source = "The paper's words."
+"#
+            )
+        };
+        let root = tempfile::tempdir().unwrap();
+        let output = root.path().join("output");
+        let judge_with = |factor: f64, l1: [(&str, f64); 4]| {
+            let p = registry::parse(&root.path().join("problems/c.toml"), &src(factor), "quick").unwrap();
+            for c in &p.cases {
+                let e = Entry::new(&output, &p, c);
+                std::fs::create_dir_all(&e.dir).unwrap();
+                let v = l1.iter().find(|(n, _)| *n == c.name).unwrap().1;
+                completed(c.params.to_json(), 144, v).write(&e.dir).unwrap();
+            }
+            judge(&p, &p.claims[0], &output).own
+        };
+        // Mean IPST 0.15 against SPST 0.2, but IPST is the higher at 16 x 16.
+        let j =
+            judge_with(1.0, [("sun-nx12", 0.35), ("ipst-nx12", 0.1), ("sun-nx16", 0.05), ("ipst-nx16", 0.2)]);
+        assert_eq!(j.verdict, Verdict::NotReproduced, "{}", j.detail);
+        assert!(j.detail.contains("16 x 16: IPST") && j.detail.contains("> "), "{}", j.detail);
+        let j =
+            judge_with(1.0, [("sun-nx12", 0.35), ("ipst-nx12", 0.1), ("sun-nx16", 0.3), ("ipst-nx16", 0.2)]);
+        assert_eq!(j.verdict, Verdict::Reproduced, "{}", j.detail);
+        // A margin of 0.5: 0.2 / 0.3 does not clear it.
+        let j =
+            judge_with(0.5, [("sun-nx12", 0.35), ("ipst-nx12", 0.1), ("sun-nx16", 0.3), ("ipst-nx16", 0.2)]);
+        assert_eq!(j.verdict, Verdict::NotReproduced, "{}", j.detail);
+        assert!(j.detail.contains("(ratio 0.67)"), "{}", j.detail);
+    }
+
     /// A profile figure: one curve per case that has a result and the file, the reference
     /// drawn as points, the manuscript's numbers and the verdicts on the figure's claims:
     /// met, missed (with the number), and not run (the paper's lattices have no result, with
@@ -751,6 +810,16 @@ source = "A marker's size."
         let Block::Image { ours, .. } = &r.items[0].item.blocks[0] else { panic!() };
         assert!(ours.contains("No result for: nx16"), "{ours}");
         assert_eq!(r.verdicts[0].own.verdict, Verdict::NotRun);
+        // ... unless a case that has run already fails the test: "within 0.15 in every
+        // case" is false whatever nx16 gives; "at least 0.05" waits for it.
+        let (v1, v3) = (&r.verdicts[1].own, &r.verdicts[3].own);
+        assert_eq!((v1.verdict, v3.verdict), (Verdict::NotReproduced, Verdict::NotRun));
+        assert!(
+            v1.detail.contains("12 x 12: 0.200 > 0.15")
+                && v1.detail.contains("no result for 1 of the 2 case(s)"),
+            "{}",
+            v1.detail
+        );
 
         // A diverged case is a result without metrics: the claim is not reproduced, and says
         // where it blew up.

@@ -8,8 +8,7 @@ use crate::solver::kernel::KernelKind;
 use crate::solver::passes::{rates, FluidPasses};
 use crate::solver::schedule::Wavefront;
 use crate::solver::scheme::{
-    Corrections, FluidSettings, Pst, SchemeName, Shifting, SolidGradient, SolidSchemeName, SolidSettings,
-    Transport,
+    Corrections, FluidSettings, Pst, SchemeName, Shifting, SolidSchemeName, SolidSettings, Transport,
 };
 use crate::solver::systems::{FluidInit, FluidWork, SolidInit, SolidMaterial};
 
@@ -328,9 +327,7 @@ fn the_wavefront_step_is_the_sweeps_bit_for_bit() {
 /// three sub-steps a step and on none.
 #[test]
 fn momentum_crosses_the_fluid_structure_interface_without_loss() {
-    use crate::solver::scheme::{
-        Corrections, PressureReference, SolidGradient, SolidSchemeName, SolidSettings,
-    };
+    use crate::solver::scheme::{Corrections, PressureReference, SolidSchemeName, SolidSettings};
     use crate::solver::systems::{BoundaryMaterial, SolidInit, SolidMaterial};
     for substeps in [Substeps::Fixed(3), Substeps::Fixed(1)] {
         let n = 24;

@@ -411,7 +411,7 @@ impl<const D: usize> ElasticSolid<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::solver::scheme::{Pst, SolidGradient, SolidSchemeName, SolidSettings};
+    use crate::solver::scheme::{Pst, SolidSchemeName, SolidSettings};
 
     fn physics() -> SolidScheme {
         SolidSchemeName::Ctvf.solid_scheme(&SolidSettings::for_tests(Pst::Sun, 1.0)).unwrap()
