@@ -921,6 +921,7 @@ source = "The paper's words."
             steps: 1000,
             final_time: 2.0,
             wall_seconds: 10.0,
+            cpu_seconds: None,
             particle_steps_per_second: 4e4,
             threads: 1,
             wavefront_steps: 0,

@@ -417,6 +417,7 @@ fn summary(
         steps,
         final_time: scene.time(),
         wall_seconds: t0.elapsed().as_secs_f64(),
+        cpu_seconds: crate::solver::output::summary::process_cpu_seconds(),
         particle_steps_per_second: if stepping > 0.0 {
             particles as f64 * steps as f64 / stepping
         } else {

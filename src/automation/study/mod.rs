@@ -674,6 +674,7 @@ source = "A marker's size."
             steps: 10,
             final_time: 1.0,
             wall_seconds: 0.1,
+            cpu_seconds: None,
             particle_steps_per_second: 1.0,
             threads: 1,
             wavefront_steps: 0,
@@ -684,6 +685,51 @@ source = "A marker's size."
             undefined_metrics: Vec::new(),
             provenance: Provenance::now(chrono::Utc::now()),
         }
+    }
+
+    /// The trade figure's cost axis is CPU time when every drawn case recorded it, and wall
+    /// time (said on the axis and in the table) while one has not.
+    #[test]
+    fn the_trade_is_drawn_against_cpu_time_where_recorded() {
+        let src = r#"
+title = "t"
+scene = "taylor_green"
+paper = "ctvf"
+[presets.quick]
+nx = [12, 16]
+[[cases]]
+name = "nx{nx}"
+grid = { nx = "$nx" }
+[[figures]]
+id = "trade"
+kind = "trade"
+title = "Trade"
+x = "nx"
+label = ["scheme"]
+metric = "l1_velocity_final"
+caption = "Cost."
+"#;
+        let root = tempfile::tempdir().unwrap();
+        let (output, manuscript) = (root.path().join("output"), root.path().join("manuscript"));
+        let p = registry::parse(&root.path().join("problems/t.toml"), src, "quick").unwrap();
+        let write = |cpu: [Option<f64>; 2]| {
+            for (c, cpu) in p.cases.iter().zip(cpu) {
+                let e = Entry::new(&output, &p, c);
+                std::fs::create_dir_all(&e.dir).unwrap();
+                Summary { cpu_seconds: cpu, ..completed(c.params.to_json(), 144, 0.1) }
+                    .write(&e.dir)
+                    .unwrap();
+            }
+            regenerate(&p, &output, &manuscript).unwrap();
+            std::fs::read_to_string(manuscript.join("tables/trade.md")).unwrap()
+        };
+        let table = write([Some(0.25), Some(0.5)]);
+        assert!(
+            table.contains("CPU time (s)") && table.contains("0.25") && !table.contains("wall time"),
+            "{table}"
+        );
+        let table = write([Some(0.25), None]);
+        assert!(table.contains("wall time (s)") && table.contains("0.10"), "{table}");
     }
 
     /// A comparative claim over a study holds at each of its resolutions, not on the mean:

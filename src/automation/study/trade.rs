@@ -52,19 +52,26 @@ pub(super) fn trade(
 ) -> Result<Drawn, String> {
     let m = f.metric.as_deref().expect("validated");
     let caption = f.info.caption.clone();
-    let done: Vec<(&Run, f64, f64, f64)> = rs
-        .iter()
-        .filter_map(|r| {
-            let s = r.summary.as_ref()?;
-            let e = r.metric(m)?;
-            Some((r, e, s.wall_seconds, s.particles as f64 * s.steps as f64))
+    // CPU time where every drawn case recorded it (a loaded machine inflates wall time and
+    // reorders the front), wall time otherwise, said on the axis.
+    let drawn: Vec<(&Run, f64)> =
+        rs.iter().filter(|r| r.summary.is_some()).filter_map(|r| Some((r, r.metric(m)?))).collect();
+    let cpu = !drawn.is_empty()
+        && drawn.iter().all(|(r, _)| r.summary.as_ref().is_some_and(|s| s.cpu_seconds.is_some()));
+    let done: Vec<(&Run, f64, f64, f64)> = drawn
+        .into_iter()
+        .map(|(r, e)| {
+            let s = r.summary.as_ref().expect("drawn");
+            let t = if cpu { s.cpu_seconds.expect("recorded") } else { s.wall_seconds };
+            (r, e, t, s.particles as f64 * s.steps as f64)
         })
         .collect();
+    let time = if cpu { "CPU time (s)" } else { "wall time (s)" };
     let machines =
         machines_note(done.iter().map(|d| &d.0.summary.as_ref().expect("done").provenance.machine));
     let at = |r: &Run| words::phrase(res, &r.case.params.0[res]);
     let mut blocks = Vec::new();
-    for (suffix, what, idx) in [("wall", "wall time (s)", 0), ("steps", "particle-steps (-)", 1)] {
+    for (suffix, what, idx) in [("wall", time, 0), ("steps", "particle-steps (-)", 1)] {
         let id = format!("{}_{suffix}", f.id);
         let points = done
             .iter()
@@ -159,11 +166,11 @@ pub(super) fn trade(
                 "fluid particles",
                 "wall particles",
                 "steps",
-                "wall time (s)",
+                time,
                 "particle-steps",
                 m,
                 "order",
-                "Pareto (wall time)",
+                &format!("Pareto ({})", time.trim_end_matches(" (s)")),
             ]
             .iter()
             .map(|s| s.to_string())

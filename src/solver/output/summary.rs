@@ -105,6 +105,20 @@ impl Provenance {
     }
 }
 
+/// The user plus system CPU time this process has spent so far, in seconds (all its
+/// threads), from `getrusage`; `None` where the OS does not tell.
+pub fn process_cpu_seconds() -> Option<f64> {
+    let mut u = std::mem::MaybeUninit::<libc::rusage>::zeroed();
+    // SAFETY: getrusage writes a whole `rusage` into the pointer it is given.
+    let ok = unsafe { libc::getrusage(libc::RUSAGE_SELF, u.as_mut_ptr()) } == 0;
+    ok.then(|| {
+        // SAFETY: initialised by the successful call above.
+        let u = unsafe { u.assume_init() };
+        let secs = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+        secs(u.ru_utime) + secs(u.ru_stime)
+    })
+}
+
 fn hostname() -> String {
     std::fs::read_to_string("/proc/sys/kernel/hostname")
         .or_else(|_| std::fs::read_to_string("/etc/hostname"))
@@ -131,6 +145,11 @@ pub struct Summary {
     pub final_time: f64,
     /// Wall-clock seconds of the whole run.
     pub wall_seconds: f64,
+    /// CPU seconds (user + system, all threads) the run's process spent, from the OS
+    /// ([`process_cpu_seconds`]): the cost a loaded machine does not inflate as it does the
+    /// wall time. Absent in summaries written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_seconds: Option<f64>,
     /// particles x steps / seconds spent stepping.
     pub particle_steps_per_second: f64,
     /// Rayon threads.
