@@ -111,6 +111,8 @@ impl Expand<'_> {
             ("time", f.time.is_some(), "particles"),
             ("arrows", f.arrows.is_some(), "particles"),
             ("x_spacing", f.x_spacing, "trade"),
+            ("exact", f.exact.is_some(), "timeseries"),
+            ("exact_label", f.exact_label.is_some(), "timeseries"),
             ("above_max", f.above_max.is_some(), "stability"),
         ] {
             if set && f.kind != only {
@@ -285,7 +287,11 @@ impl Expand<'_> {
                 ));
             }
         }
-        Ok(FigureKind::Timeseries { y, exact: f.exact.clone() })
+        if f.exact_label.is_some() && f.exact.is_none() {
+            return Err(self.loc.err(span, &format!("{key}.exact_label"), "names no `exact` column"));
+        }
+        let exact_label = f.exact_label.clone().unwrap_or_else(|| "exact".into());
+        Ok(FigureKind::Timeseries { y, exact: f.exact.clone(), exact_label })
     }
 
     /// A `particles` figure of point array `field`: its `time` is one every selected case
@@ -675,6 +681,14 @@ mod tests {
         assert!(e.contains("`figures.f1.above_max`") && e.contains("`<b>` must be a short word"), "{e}");
         let e = p(&kind("trade", "\nx = \"nx\"\nabove_max = \"lost\"")).unwrap_err();
         assert!(e.contains("only kind `stability` takes `above_max`"), "{e}");
+        // The exact curve's legend entry: on a timeseries with an `exact` column only.
+        let ts =
+            |extra: &str| GOOD.replace("kind = \"timeseries\"", &format!("kind = \"timeseries\"{extra}"));
+        assert!(p(&ts("\nexact = \"u_max_exact\"\nexact_label = \"Taylor-Green\"")).is_ok());
+        let e = p(&ts("\nexact_label = \"Taylor-Green\"")).unwrap_err();
+        assert!(e.contains("`figures.f1.exact_label`") && e.contains("names no `exact` column"), "{e}");
+        let e = p(&kind("trade", "\nx = \"nx\"\nexact = \"u_max_exact\"")).unwrap_err();
+        assert!(e.contains("only kind `timeseries` takes `exact`"), "{e}");
         // Two cases in one cell of the map (nx = 16: SPST and EDAC, no `label` to part them).
         let e = p(&kind("stability", "\nx = \"nx\"\nmax = 0.1").replace("cases = [\"sun-*\"]\n", ""))
             .unwrap_err();

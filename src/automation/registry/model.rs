@@ -75,6 +75,9 @@ pub enum FigureKind {
         y: String,
         /// Column holding the exact solution.
         exact: Option<String>,
+        /// Its legend entry: what the solution is ("exact" unless the problem names it, as
+        /// where the reference is exact only for another set-up).
+        exact_label: String,
     },
     /// The particles of one case's snapshot (the last one, or the one nearest `time`),
     /// coloured by a point array, with an optional vector array drawn as short segments.

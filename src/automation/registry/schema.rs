@@ -103,6 +103,8 @@ pub(super) struct FigureFile {
     #[serde(default)]
     pub(super) exact: Option<String>,
     #[serde(default)]
+    pub(super) exact_label: Option<String>,
+    #[serde(default)]
     pub(super) y_label: Option<String>,
     #[serde(default)]
     pub(super) log_y: bool,

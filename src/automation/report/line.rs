@@ -108,6 +108,14 @@ impl Render for LineFigure {
         canvas::mesh(&mut chart, &self.x_label, &self.y_label, true)?;
 
         let mut colour_index = 0;
+        // Solid curves drawn widest first, each later one narrower (down to 2 px): a curve
+        // that lies on an earlier one shows inside it rather than hiding it.
+        let solid = self
+            .series
+            .iter()
+            .filter(|s| !matches!(s.style, SeriesStyle::Dashed | SeriesStyle::Reference))
+            .count();
+        let width = |i: usize| 2 + (2 * (solid.saturating_sub(1 + i))).min(6) as u32;
         // Each set of published points its own marker: squares, then triangles, diamonds.
         let mut reference_index = 0;
         for (s, runs) in self.series.iter().zip(&runs) {
@@ -119,7 +127,7 @@ impl Render for LineFigure {
                 colour_index += 1;
                 palette(colour_index - 1)
             };
-            let line = color.stroke_width(if dashed { 2 } else { 3 });
+            let line = color.stroke_width(if dashed || reference { 2 } else { width(colour_index - 1) });
             let with_line = !matches!(s.style, SeriesStyle::Points | SeriesStyle::Reference);
             let with_marks =
                 matches!(s.style, SeriesStyle::Points | SeriesStyle::LinePoints | SeriesStyle::Reference);

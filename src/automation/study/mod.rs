@@ -374,14 +374,19 @@ fn prepare(
         Prepared::Lines(fig, numbers(f, &rs))
     };
     Ok(match &f.kind {
-        FigureKind::Timeseries { y, exact } => {
+        FigureKind::Timeseries { y, exact, exact_label } => {
             let mut series = Vec::new();
             for r in rs.iter().filter(|r| r.summary.is_some() && r.dir().join("timeseries.csv").exists()) {
                 let (t, v) = timeseries(p, r, y)?;
                 if series.is_empty() {
                     if let Some(ex) = exact {
                         let (t, v) = timeseries(p, r, ex)?;
-                        series.push(Series { label: "exact".into(), x: t, y: v, style: SeriesStyle::Dashed });
+                        series.push(Series {
+                            label: exact_label.clone(),
+                            x: t,
+                            y: v,
+                            style: SeriesStyle::Dashed,
+                        });
                     }
                 }
                 series.push(Series { label: group(r.case, &f.label), x: t, y: v, style: SeriesStyle::Line });
