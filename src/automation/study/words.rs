@@ -65,6 +65,34 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("vf", _) => format!("V_f = {}", num()),
         ("poisson_ratio", _) => format!("nu = {}", num()),
         ("nz", _) => format!("{} layers deep", num()),
+        ("gradient", "paper") => "the paper's kernel gradient".into(),
+        ("gradient", "corrected") => "corrected kernel gradient".into(),
+        ("surface_shift", "normal") => "shift's normal part removed near the surface".into(),
+        ("surface_shift", "outward") => "shift's outward part removed near the surface".into(),
+        ("platens", "bonded") => "bonded to the platens".into(),
+        ("platens", "frictionless") => "frictionless platens".into(),
+        ("rings", "two_bodies") => "rings as two bodies".into(),
+        ("rings", "one_body") => "rings as one body".into(),
+        ("shift_speed", _) if number_value(v) == Some(0.0) => "shifting speed v0".into(),
+        ("shift_speed", _) => format!("shifting speed {} m/s", num()),
+        ("ipst_test", "two_sided") => "IPST's test two-sided".into(),
+        ("ipst_test", "one_sided") => "IPST's test one-sided".into(),
+        ("wall_viscosity", "wall") => "viscosity with the wall's velocity".into(),
+        ("wall_viscosity", "no_slip") => "viscosity with the no-slip velocity".into(),
+        ("surface_cone", "support") => "60-degree test over the support".into(),
+        ("surface_cone", "fluid_2h") => "60-degree test over the fluid within 2h".into(),
+        ("substeps", "auto") => "sub-steps as its own time step needs".into(),
+        ("substeps", _) if number_value(v) == Some(1.0) => "no sub-steps".into(),
+        ("substeps", _) => format!("{} sub-steps", num()),
+        // A structure's switches (`solid_pst`, `solid_gradient`, ...) read as the solid's.
+        (k, _) if k.starts_with("solid_") && k != "solid_scheme" => {
+            let inner = phrase(&k["solid_".len()..], v);
+            if inner.is_empty() {
+                inner
+            } else {
+                format!("structure: {inner}")
+            }
+        }
         _ => format!("{key} = {v}"),
     }
 }
@@ -77,8 +105,9 @@ pub(crate) fn value(v: &Value) -> String {
 /// A number as it reads in text: integers without a decimal point.
 fn number(v: &Value) -> String {
     match v {
-        Value::Float(x) if x.abs() >= 1e6 && x.is_finite() => format!("{x:e}"),
-        Value::Int(i) if i.abs() >= 1_000_000 => format!("{:e}", *i as f64),
+        // From 1e5 on in powers of ten, so that a row of 1e5, 1e6, 1e7 reads alike.
+        Value::Float(x) if x.abs() >= 1e5 && x.is_finite() => format!("{x:e}"),
+        Value::Int(i) if i.abs() >= 100_000 => format!("{:e}", *i as f64),
         Value::Float(x) if x.fract() == 0.0 && x.abs() < 1e15 => format!("{}", *x as i64),
         other => other.to_string(),
     }
@@ -137,6 +166,13 @@ mod tests {
         assert_eq!(phrase("frobs", &Value::Int(3)), "frobs = 3");
         assert_eq!(value(&Value::Float(1e9)), "1e9");
         assert_eq!(value(&Value::Int(1_000_000)), "1e6");
+        assert_eq!(value(&Value::Float(100_000.0)), "1e5");
+        assert_eq!(phrase("solid_pst", &Value::Str("ipst".into())), "structure: IPST");
+        assert_eq!(
+            phrase("solid_substeps", &Value::Str("auto".into())),
+            "structure: sub-steps as its own time step needs"
+        );
+        assert_eq!(phrase("solid_substeps", &Value::Int(1)), "structure: no sub-steps");
     }
 
     /// GTVF's legend names its own homogenisation, not "no shifting"; Gray's keeps it.
