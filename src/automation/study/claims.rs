@@ -3,8 +3,9 @@
 //! case's number against the test) or `not run` (results missing at that preset, with an
 //! estimate of what they would cost). A case that ran and fails the test on its own (it
 //! diverged, or breaks the bound) makes the claim `not reproduced` even while others are
-//! missing: a failure at the claim's resolution is never hidden as `not run`. When the claim's own preset has no results and another
-//! preset does, the verdict there is given too, labelled as drawn at that resolution.
+//! missing: a failure at the claim's resolution is never hidden as `not run`. When the
+//! claim's own preset has no results and another preset does, the verdict there is given
+//! too, labelled as drawn at that resolution.
 
 use super::words;
 use super::{fmt_bound, fmt_value, param_f64};
@@ -200,13 +201,19 @@ fn fails_alone(test: &Test, v: &Outcome) -> bool {
     match (test, v) {
         (_, Outcome::Missing) => false,
         (_, Outcome::NoMetric) => true,
-        (Test::Bound { max, min, .. }, Outcome::Value(x)) => {
-            max.is_some_and(|m| x.is_nan() || *x > m) || min.is_some_and(|m| x.is_nan() || *x < m)
-        }
+        (Test::Bound { max, min, .. }, Outcome::Value(x)) => !mark(*max, *min, *x).is_empty(),
         (_, Outcome::Value(_)) => false,
         (Test::Bound { max: None, min: Some(m), .. }, Outcome::Diverged(_, _, Some(x))) => *x < *m,
         (_, Outcome::Diverged(..)) => true,
     }
+}
+
+/// The key of `case`'s group: its parameters but those `apart` names (the ones a test
+/// compares along), so that cases alike in all else share a key.
+fn group_key(case: &Case, apart: impl Fn(&str) -> bool) -> String {
+    let key: Vec<String> =
+        case.params.0.iter().filter(|(k, _)| !apart(k)).map(|(k, v)| format!("{k}={v}")).collect();
+    key.join(",")
 }
 
 /// The parameters that tell `cases` apart, in the order the first case lists them (its
@@ -271,6 +278,13 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
         Outcome::NoMetric => format!("{}: no `{metric}`", name(c)),
         Outcome::Missing => format!("{}: no result", name(c)),
     };
+    // A case as the test reads it: a value with the bound it breaks.
+    let show_tested = |c: &Case, v: &Outcome| match (&ct.test, v) {
+        (Test::Bound { max, min, .. }, Outcome::Value(x)) => {
+            format!("{}{}", show(c, v), mark(*max, *min, *x))
+        }
+        _ => show(c, v),
+    };
     if !missing.is_empty() {
         let list: Vec<String> = missing
             .iter()
@@ -286,12 +300,7 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
         let failed: Vec<String> = results
             .iter()
             .filter(|(_, v)| fails_alone(&ct.test, v))
-            .map(|(c, v)| match (&ct.test, v) {
-                (Test::Bound { max, min, .. }, Outcome::Value(x)) => {
-                    format!("{}{}", show(c, v), mark(*max, *min, *x))
-                }
-                _ => show(c, v),
-            })
+            .map(|(c, v)| show_tested(c, v))
             .collect();
         if failed.is_empty() {
             return j(Verdict::NotRun, not_run);
@@ -304,9 +313,9 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
             let parts: Vec<String> = results
                 .iter()
                 .map(|(c, v)| match v {
-                    Outcome::Value(x) => {
+                    Outcome::Value(_) => {
                         ok &= !fails_alone(&ct.test, v);
-                        format!("{}{}", show(c, v), mark(*max, *min, *x))
+                        show_tested(c, v)
                     }
                     // A running record over a lower bound only: it passed before the blow-up
                     // and cannot fall back.
@@ -328,9 +337,7 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
             // Groups of cases alike but in `param`, each sorted along it.
             let mut groups: BTreeMap<String, Vec<(&Case, &Outcome)>> = BTreeMap::new();
             for (c, v) in &results {
-                let key: Vec<String> =
-                    c.params.0.iter().filter(|(k, _)| *k != param).map(|(k, v)| format!("{k}={v}")).collect();
-                groups.entry(key.join(",")).or_default().push((c, v));
+                groups.entry(group_key(c, |k| k == param)).or_default().push((c, v));
             }
             let group_keys: Vec<String> = keys.iter().filter(|k| *k != param).cloned().collect();
             let mut ok = true;
@@ -382,9 +389,8 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
             )
         }
         Test::LowerThan { lower, higher, factor, .. } => {
-            // The comparison holds in every group of cases alike but in the parameters the
-            // two sides are told apart by (each resolution of a study on its own), not on a
-            // mean that one group can carry.
+            // The comparison holds in every group of cases alike but in the sides' parameters
+            // (each resolution of a study on its own), not on a mean that one group can carry.
             // The sides' parameters: those the two sides hold no value of in common (the
             // `where` keys, or what tells cases picked by name apart).
             let values = |s: &Select, k: &String| -> Vec<String> {
@@ -407,14 +413,7 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
                 .collect();
             let mut groups: BTreeMap<String, Vec<&(&Case, Outcome)>> = BTreeMap::new();
             for r in &results {
-                let key: Vec<String> =
-                    r.0.params
-                        .0
-                        .iter()
-                        .filter(|(k, _)| !sides.contains(k))
-                        .map(|(k, v)| format!("{k}={v}"))
-                        .collect();
-                groups.entry(key.join(",")).or_default().push(r);
+                groups.entry(group_key(r.0, |k| sides.iter().any(|s| s.as_str() == k))).or_default().push(r);
             }
             let group_keys: Vec<String> = keys.iter().filter(|k| !sides.contains(k)).cloned().collect();
             let describe_side = |s: &Select| -> String {
