@@ -85,7 +85,7 @@ pub(crate) fn phrase(key: &str, v: &Value) -> String {
         ("substeps", _) if number_value(v) == Some(1.0) => "no sub-steps".into(),
         ("substeps", _) => format!("{} sub-steps", num()),
         // A structure's switches (`solid_pst`, `solid_gradient`, ...) read as the solid's.
-        (k, _) if k.starts_with("solid_") && k != "solid_scheme" => {
+        (k, _) if k.starts_with("solid_") => {
             let inner = phrase(&k["solid_".len()..], v);
             if inner.is_empty() {
                 inner
@@ -173,6 +173,7 @@ mod tests {
             "structure: sub-steps as its own time step needs"
         );
         assert_eq!(phrase("solid_substeps", &Value::Int(1)), "structure: no sub-steps");
+        assert_eq!(phrase("solid_scheme", &Value::Str("ctvf".into())), "structure: CTVF");
     }
 
     /// GTVF's legend names its own homogenisation, not "no shifting"; Gray's keeps it.
