@@ -81,9 +81,17 @@ struct RunArgs {
     /// Concurrent cases (default: the core count; cores are split between cases and threads).
     #[arg(long, value_parser = at_least_one::<usize>)]
     jobs: Option<usize>,
-    /// Print what would run and why; run nothing.
+    /// Print what would run and why, with each case's estimated CPU-hours and peak memory
+    /// (from a short run of it, kept for the next dry run); run nothing.
     #[arg(long)]
     dry_run: bool,
+    /// With --dry-run: list the cases without estimating what they cost.
+    #[arg(long, requires = "dry_run")]
+    no_estimate: bool,
+    /// With --dry-run: CPU seconds of timed steps in each case's short run (longer: closer
+    /// estimates); estimates kept from an earlier dry run are reused whatever their budget.
+    #[arg(long, value_name = "SECONDS", requires = "dry_run", default_value_t = sphrepro::automation::estimate::BUDGET, value_parser = positive_seconds)]
+    estimate_budget: f64,
     /// Regenerate figures and tables from cached and committed results without simulating.
     #[arg(long)]
     plot_only: bool,
@@ -187,6 +195,7 @@ impl RunArgs {
             force: self.force,
             matching: self.matching.clone(),
             dry_run: self.dry_run,
+            estimate: (self.dry_run && !self.no_estimate).then_some(self.estimate_budget),
             checkpoint_every: Some(30.0),
         }
     }
@@ -414,6 +423,18 @@ enum Command {
         #[arg(long)]
         steps: Option<u64>,
     },
+    /// One case's cost predicted from a short run of it in this process (used by
+    /// `run --dry-run`).
+    #[command(hide = true)]
+    EstimateCase {
+        #[arg(long)]
+        scene: String,
+        #[arg(long = "set")]
+        sets: Vec<String>,
+        /// CPU seconds of timed stepping.
+        #[arg(long)]
+        budget: f64,
+    },
 }
 
 fn main() -> ExitCode {
@@ -541,6 +562,7 @@ fn run(cli: Cli) -> u8 {
             None => bench::run(&args.options()),
         },
         Command::BenchScene { scene, sets, steps } => bench::scene_child(&scene, &sets, steps),
+        Command::EstimateCase { scene, sets, budget } => bench::estimate_child(&scene, &sets, budget),
         Command::BenchCase { variant, nx, steps, kernel } => bench::case_child(&variant, nx, steps, &kernel),
         Command::BenchInterleaved { variants, nx, bench_threads, steps, rounds, kernel } => {
             bench::interleaved_child(&variants, nx, &bench_threads, steps, rounds, &kernel)

@@ -3,7 +3,7 @@
 
 use super::registry::{self, Problem};
 use super::runner::{self, Options};
-use super::{baseline, cache, check, results, slurm, study};
+use super::{baseline, cache, check, estimate, results, slurm, study};
 use crate::{errln, outln};
 use std::path::{Path, PathBuf};
 
@@ -185,16 +185,32 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
             return OK;
         }
         if opts.dry_run {
-            for t in &tasks {
+            let cores = rayon::current_num_threads();
+            let costs = match opts.estimate {
+                Some(budget) if !tasks.is_empty() => {
+                    estimate::estimates(&dirs.output, &problems, &tasks, opts.jobs.unwrap_or(cores), budget)
+                }
+                _ => Vec::new(),
+            };
+            for (i, t) in tasks.iter().enumerate() {
+                let cost = match costs.get(i) {
+                    Some(Ok(m)) => format!("  [{}]", estimate::describe(m)),
+                    Some(Err(e)) => format!("  [no estimate: {e}]"),
+                    None => String::new(),
+                };
                 outln!(
-                    "would run {}/{} ({})  -> {}",
+                    "would run {}/{} ({})  -> {}{cost}",
                     t.problem,
                     t.entry.case.name,
                     t.reason,
                     t.entry.dir.display()
                 );
             }
-            outln!("{} to run, {done} done (skipped)", tasks.len());
+            if costs.is_empty() {
+                outln!("{} to run, {done} done (skipped)", tasks.len());
+            } else {
+                outln!("{} to run, {done} done (skipped); {}", tasks.len(), estimate::total(&costs, cores));
+            }
             return OK;
         }
         if let Err(e) = ensure_dir(&dirs.output, "output") {

@@ -7,7 +7,8 @@
 //!   export;
 //! - [`reads`]: what the figures and tables read from a case's folder, which a committed
 //!   result must hold to be done;
-//! - [`runner`]: a job pool of `simulate` subprocesses;
+//! - [`runner`]: a job pool of `simulate` subprocesses; [`estimate`]: what the cases would
+//!   cost, from a short run of each, before they run;
 //! - [`slurm`]: the same cases as job arrays on a Slurm cluster;
 //! - [`check`]: bounds for CI and case states; [`baseline`]: the quick preset's results
 //!   committed as regression baselines, compared metric by metric, rewritten by `bless`;
@@ -23,6 +24,7 @@ pub mod baseline;
 pub mod cache;
 pub mod check;
 pub mod commands;
+pub mod estimate;
 pub mod lock;
 pub mod papers;
 pub mod reads;

@@ -15,7 +15,8 @@
 //! the stability maps at the other presets (for their first-failure tables): those folders
 //! hold a [`SUMMARY_ONLY`] file and are not done cases for the cache. The folder is kept
 //! under [`BUDGET`] bytes: past it, the largest snapshots are dropped (named), and the figures
-//! that draw them say so.
+//! that draw them say so. The estimated cost of the cases without a result goes there too
+//! (`estimates.json`, [`estimate`](super::estimate)).
 
 use super::cache::{self, root, Entry, SUMMARY_ONLY};
 use super::reads::{self, Need};
@@ -183,6 +184,8 @@ pub fn export(problems: &[Problem], output: &Path) -> Result<Exported, String> {
             put(&to.join(SUMMARY_ONLY), SUMMARY_ONLY_TEXT.as_bytes())?;
             out.summaries += 1;
         }
+        // What the cases still without a result would cost, where a dry run measured it.
+        super::estimate::export(output, p)?;
         // Folders of earlier inputs.
         let live: Vec<PathBuf> = p
             .presets()

@@ -30,6 +30,9 @@ pub struct Options {
     pub matching: Option<String>,
     /// Print the plan, run nothing.
     pub dry_run: bool,
+    /// With `dry_run`: each case's cost, measured from a short run of it with this budget of
+    /// CPU seconds of timed steps ([`estimate`](super::estimate)).
+    pub estimate: Option<f64>,
     /// Checkpoint interval passed to `simulate` (seconds), when it supports it.
     pub checkpoint_every: Option<f64>,
 }

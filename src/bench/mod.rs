@@ -13,9 +13,11 @@
 //! - `peer`: the peer code's runs and our accuracy on them;
 //! - `report`: the Markdown table and what is printed;
 //! - `targets`: the throughput targets and whether the runs meet them;
-//! - `scene`: `bench --scene`, any registered scene at its parameters, per thread count.
+//! - `scene`: `bench --scene`, any registered scene at its parameters, per thread count;
+//! - `estimate`: a whole run's cost predicted from a short run of it (`run --dry-run`).
 
 mod case;
+mod estimate;
 mod peer;
 mod process;
 mod report;
@@ -26,6 +28,7 @@ mod targets;
 mod timing;
 
 pub use case::DEFAULT_KERNEL;
+pub use estimate::{estimate_child, Estimate};
 pub use process::{case_child, interleaved_child};
 pub use run::{run, Options};
 pub use scene::{run_scene, scene_child, SceneOptions};

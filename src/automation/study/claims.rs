@@ -483,11 +483,19 @@ pub fn judge_at(p: &Problem, claim: &Claim, preset: &str, output: &Path) -> Judg
 /// The parameters that set a case's size and length, and how its cost grows with each.
 const SIZE_KEYS: [&str; 4] = ["nx", "dx", "tf", "nz"];
 
-/// An estimate of what `case` would take, scaled from the most similar finished case of
-/// the problem (any preset, either layer): the fewest other differing parameters, then the
-/// nearest in size. Wall time grows as particles times steps: (nx ratio)^(dim + 1) or
-/// (dx ratio)^-(dim + 1), tf and nz linearly.
+/// An estimate of what `case` would take: the one a dry run measured from a short run of
+/// the case ([`estimate`](crate::automation::estimate)), else one scaled from the most
+/// similar finished case of the problem (any preset, either layer): the fewest other
+/// differing parameters, then the nearest in size. Wall time grows as particles times
+/// steps: (nx ratio)^(dim + 1) or (dx ratio)^-(dim + 1), tf and nz linearly.
 pub fn estimate(p: &Problem, case: &Case, output: &Path) -> Option<String> {
+    if let Some(m) = crate::automation::estimate::stored(output, p, &Entry::new(output, p, case)) {
+        return Some(format!(
+            "estimated {} of CPU on 1 thread, {}, from a short run of it",
+            duration(m.estimate.cpu_seconds),
+            crate::automation::estimate::bytes(m.estimate.peak_rss_bytes)
+        ));
+    }
     let dim = p.scene.dim as i32;
     let mut best: Option<(usize, f64, &Case, Summary)> = None;
     for (_, cases) in p.presets() {

@@ -16,6 +16,7 @@ mod trade;
 pub(crate) mod words;
 
 pub use assemble::{manuscript, Header};
+pub(crate) use claims::duration;
 pub use claims::{judge, judge_all, judge_at, ClaimVerdict, Judgement, Verdict};
 
 use super::cache::Entry;
