@@ -188,7 +188,7 @@ pub fn run(dirs: &Dirs, preset: &str, only: &[String], opts: &Options, flags: &R
             let cores = rayon::current_num_threads();
             let costs = match opts.estimate {
                 Some(budget) if !tasks.is_empty() => {
-                    estimate::estimates(&dirs.output, &problems, &tasks, opts.jobs.unwrap_or(cores), budget)
+                    estimate::estimates(&tasks, opts.jobs.unwrap_or(cores), budget)
                 }
                 _ => Vec::new(),
             };

@@ -57,12 +57,12 @@ fn write_store(path: &Path, store: &Store) -> Result<(), String> {
     write_atomic(path, text.as_bytes()).map_err(|e| format!("{}: {e}", path.display()))
 }
 
-/// The stored estimate of `entry` (case of `problem`): the output folder's, else the
-/// committed one.
-pub fn stored(output: &Path, problem: &Problem, entry: &Entry) -> Option<Measured> {
+/// The stored estimate of `entry`: its output folder's store (beside the case's folder),
+/// else the committed one.
+pub fn stored_for(entry: &Entry) -> Option<Measured> {
     let folder = entry.record.folder();
-    let mut places = vec![output.join(&problem.name).join(FILE)];
-    places.extend(cache::root(problem).map(|r| r.join(&problem.name).join(FILE)));
+    let mut places: Vec<PathBuf> = entry.dir.parent().map(|d| d.join(FILE)).into_iter().collect();
+    places.extend(entry.committed.as_deref().and_then(Path::parent).map(|d| d.join(FILE)));
     places.into_iter().find_map(|p| read_store(&p).remove(&folder))
 }
 
@@ -86,16 +86,9 @@ fn measure(exe: &Path, entry: &Entry, budget: f64) -> Result<Estimate, String> {
 /// The estimate of every task, measured where none is stored (in `jobs` child processes at
 /// once, each on one thread) and stored as soon as it is; `Err` says why a case has none.
 /// Ctrl-C stops measuring: the cases not measured then have none.
-pub fn estimates(
-    output: &Path,
-    problems: &[Problem],
-    tasks: &[Task],
-    jobs: usize,
-    budget: f64,
-) -> Vec<Result<Measured, String>> {
-    let problem_of = |t: &Task| problems.iter().find(|p| p.name == t.problem).expect("a task's problem");
+pub fn estimates(tasks: &[Task], jobs: usize, budget: f64) -> Vec<Result<Measured, String>> {
     let mut out: Vec<Option<Result<Measured, String>>> =
-        tasks.iter().map(|t| stored(output, problem_of(t), &t.entry).map(Ok)).collect();
+        tasks.iter().map(|t| stored_for(&t.entry).map(Ok)).collect();
     let todo: Vec<usize> = (0..tasks.len()).filter(|&i| out[i].is_none()).collect();
     if !todo.is_empty() {
         crate::errln!(
@@ -121,7 +114,7 @@ pub fn estimates(
                     }
                     .map(|estimate| Measured { estimate, cpu: cpu.clone() });
                     if let Ok(m) = &r {
-                        let path = output.join(&t.problem).join(FILE);
+                        let path = t.entry.dir.with_file_name(FILE);
                         let mut stores = stores.lock().expect("not poisoned");
                         let store = stores.entry(path.clone()).or_insert_with(|| read_store(&path));
                         store.insert(t.entry.record.folder(), m.clone());
@@ -201,7 +194,7 @@ pub fn export(output: &Path, problem: &Problem) -> Result<(), String> {
         if e.is_done() {
             continue;
         }
-        if let Some(m) = stored(output, problem, &e) {
+        if let Some(m) = stored_for(&e) {
             store.insert(e.record.folder(), m);
         }
     }

@@ -35,6 +35,10 @@ pub struct ManifestCase {
     pub force: bool,
     /// The case's inputs, written to `case.json` when the task starts.
     pub record: CaseRecord,
+    /// Its estimated CPU seconds on one thread, where a dry run measured them (they set the
+    /// array's time limit when the settings set none).
+    #[serde(skip)]
+    pub estimate_seconds: Option<f64>,
 }
 
 /// What the tasks of one array read.

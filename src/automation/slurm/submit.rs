@@ -47,6 +47,8 @@ pub fn cases_of(tasks: &[Task], force: bool) -> Vec<ManifestCase> {
             sets: t.entry.case.params.0.iter().map(|(k, v)| format!("{k}={v}")).collect(),
             force,
             record: t.entry.record.clone(),
+            estimate_seconds: crate::automation::estimate::stored_for(&t.entry)
+                .map(|m| m.estimate.cpu_seconds),
         })
         .collect()
 }
@@ -78,6 +80,7 @@ pub fn plan(
     let mut out = Vec::new();
     for (job, list) in groups {
         for chunk in list.chunks(MAX_ARRAY) {
+            let job = with_estimated_time(&job, chunk);
             let dir = root.join(format!("{stamp}-{}-{}", std::process::id(), out.len()));
             let mut problems: Vec<&str> = chunk.iter().map(|c| c.problem.as_str()).collect();
             problems.sort_unstable();
@@ -91,6 +94,29 @@ pub fn plan(
         }
     }
     Ok(out)
+}
+
+/// Margin of a time limit taken from estimates: the estimates run low where a step grows
+/// dearer during a run (IPST in a developed flow), and a task past its limit is requeued
+/// from its checkpoint, not lost.
+const ESTIMATE_MARGIN: f64 = 1.5;
+
+/// `job` with a time limit from the estimates of `cases` where the settings set none: the
+/// largest case's CPU time over the task's CPUs, times [`ESTIMATE_MARGIN`], plus the
+/// checkpoint signal's lead and ten minutes for start-up and output, in whole minutes.
+/// Without an estimate for every case the limit stays the partition's default.
+fn with_estimated_time(job: &Job, cases: &[ManifestCase]) -> Job {
+    let longest = cases.iter().map(|c| c.estimate_seconds).try_fold(0.0_f64, |m, e| e.map(|e| m.max(e)));
+    match (&job.time, longest) {
+        (None, Some(secs)) => {
+            let limit =
+                secs / job.cpus_per_task.max(1) as f64 * ESTIMATE_MARGIN + job.signal_before as f64 + 600.0;
+            let minutes = (limit / 60.0).ceil() as u64;
+            let time = format!("{}-{:02}:{:02}:00", minutes / 1440, minutes / 60 % 24, minutes % 60);
+            Job { time: Some(time), ..job.clone() }
+        }
+        _ => job.clone(),
+    }
 }
 
 /// Writes every submission's folder, asks Slurm whether it takes each, then submits them
@@ -193,5 +219,49 @@ fn refusal(message: &str, s: &Submission, settings: &Settings) -> String {
         format!("sbatch refused the job: {message} (script: {})", s.dir.join("job.sh").display())
     } else {
         format!("sbatch refused {}: {message}", named.join(", "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::automation::cache::CaseRecord;
+
+    fn case(estimate: Option<f64>) -> ManifestCase {
+        let record = CaseRecord {
+            problem: "p".into(),
+            name: "c".into(),
+            scene: "taylor_green".into(),
+            params: Default::default(),
+            solver: String::new(),
+            key: "0".repeat(64),
+        };
+        ManifestCase {
+            problem: "p".into(),
+            case: "c".into(),
+            dir: PathBuf::from("/o/p/c"),
+            scene: "taylor_green".into(),
+            sets: Vec::new(),
+            force: false,
+            record,
+            estimate_seconds: estimate,
+        }
+    }
+
+    /// The longest case's CPU time over the task's CPUs, times 1.5, plus the signal's lead
+    /// and ten minutes, in whole minutes; only where every case has an estimate and the
+    /// settings set no limit.
+    #[test]
+    fn a_time_limit_comes_from_the_estimates_where_the_settings_set_none() {
+        let job = Job { cpus_per_task: 2, signal_before: 180, ..Job::default() };
+        // 7200 / 2 * 1.5 + 180 + 600 = 6180 s: 103 minutes.
+        let cases = [case(Some(600.0)), case(Some(7200.0))];
+        assert_eq!(with_estimated_time(&job, &cases).time.as_deref(), Some("0-01:43:00"));
+        // Two days and more.
+        let long = [case(Some(2.0 * 86_400.0 * 2.0 / 1.5))];
+        assert_eq!(with_estimated_time(&job, &long).time.as_deref(), Some("2-00:13:00"));
+        assert_eq!(with_estimated_time(&job, &[case(Some(1.0)), case(None)]).time, None);
+        let fixed = Job { time: Some("01:00:00".into()), ..job.clone() };
+        assert_eq!(with_estimated_time(&fixed, &cases).time.as_deref(), Some("01:00:00"));
     }
 }

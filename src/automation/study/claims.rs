@@ -489,7 +489,7 @@ const SIZE_KEYS: [&str; 4] = ["nx", "dx", "tf", "nz"];
 /// differing parameters, then the nearest in size. Wall time grows as particles times
 /// steps: (nx ratio)^(dim + 1) or (dx ratio)^-(dim + 1), tf and nz linearly.
 pub fn estimate(p: &Problem, case: &Case, output: &Path) -> Option<String> {
-    if let Some(m) = crate::automation::estimate::stored(output, p, &Entry::new(output, p, case)) {
+    if let Some(m) = crate::automation::estimate::stored_for(&Entry::new(output, p, case)) {
         return Some(format!(
             "estimated {} of CPU on 1 thread, {}, from a short run of it",
             duration(m.estimate.cpu_seconds),
