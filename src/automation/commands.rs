@@ -394,7 +394,9 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
         let preset = problems.first().map(|p| p.preset.as_str()).unwrap_or(registry::DEFAULT_PRESET);
         let path = dirs.manuscript.join("manuscript.md");
         let refs: Vec<(&Problem, &study::ProblemReport)> = reports.iter().map(|(p, r)| (*p, r)).collect();
-        super::report::write_manuscript(&study::manuscript(header(preset), &refs), &path)?;
+        let mut header = header(preset);
+        header.cases = Some(estimate::coverage(&read, problems));
+        super::report::write_manuscript(&study::manuscript(header, &refs), &path)?;
         outln!("wrote {}", path.display());
     }
     Ok(())
@@ -419,6 +421,7 @@ fn header(preset: &str) -> study::Header {
                 "{how}\n\nThe results are committed in `results/`, so `sphrepro reproduce --plot-only --preset {preset}` \
                  on a fresh clone redraws this manuscript, byte for byte, without simulating."
             ),
+            cases: None,
         }
     } else {
         study::Header {
@@ -429,6 +432,7 @@ fn header(preset: &str) -> study::Header {
                  resolutions come from the committed results where they exist; the manuscript of the papers' \
                  resolutions is `manuscript/manuscript.md`."
             ),
+            cases: None,
         }
     }
 }

@@ -206,3 +206,45 @@ pub fn export(output: &Path, problem: &Problem) -> Result<(), String> {
     }
     write_store(&path, &store)
 }
+
+/// What the results of `problems` cover, read from `read` (the committed results for the
+/// paper preset): per problem, its cases, those with a result, and those without one with
+/// the CPU-hours their estimates add up to (and how many have none), then the totals. The
+/// table's headers and rows.
+pub fn coverage(read: &Path, problems: &[Problem]) -> (Vec<String>, Vec<Vec<String>>) {
+    let headers =
+        ["problem", "cases", "with a result", "without", "their estimated CPU-hours", "without an estimate"]
+            .map(String::from)
+            .to_vec();
+    let mut rows = Vec::new();
+    let (mut all, mut done, mut secs, mut unknown) = (0, 0, 0.0, 0);
+    for p in problems {
+        let entries = cache::entries(read, p);
+        let have = entries.iter().filter(|e| e.is_done()).count();
+        let estimates: Vec<Option<f64>> = entries
+            .iter()
+            .filter(|e| !e.is_done())
+            .map(|e| stored_for(e).map(|m| m.estimate.cpu_seconds))
+            .collect();
+        let s: f64 = estimates.iter().flatten().sum();
+        let none = estimates.iter().filter(|e| e.is_none()).count();
+        rows.push(vec![
+            format!("`{}`", p.name),
+            entries.len().to_string(),
+            have.to_string(),
+            (entries.len() - have).to_string(),
+            if estimates.len() > none { hours(s) } else { "-".into() },
+            none.to_string(),
+        ]);
+        (all, done, secs, unknown) = (all + entries.len(), done + have, secs + s, unknown + none);
+    }
+    rows.push(vec![
+        "all".into(),
+        all.to_string(),
+        done.to_string(),
+        (all - done).to_string(),
+        hours(secs),
+        unknown.to_string(),
+    ]);
+    (headers, rows)
+}

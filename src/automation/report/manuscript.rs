@@ -20,6 +20,9 @@ pub struct Manuscript {
     pub intro: String,
     /// The summary table: headers, then one row per claim.
     pub summary: Option<(Vec<String>, Vec<Vec<String>>)>,
+    /// What the results cover, after the summary: a paragraph, then a table's headers and
+    /// rows.
+    pub coverage: Option<(String, Vec<String>, Vec<Vec<String>>)>,
     /// One part per paper (level-2 heading).
     pub parts: Vec<Part>,
 }
@@ -101,6 +104,12 @@ pub fn write_manuscript(m: &Manuscript, path: &Path) -> Result<(), String> {
     push_text(&mut out, &m.intro);
     if let Some((headers, rows)) = &m.summary {
         out += "## Summary of the verdicts\n\n";
+        out += &markdown_table(headers, rows);
+        out += "\n";
+    }
+    if let Some((text, headers, rows)) = &m.coverage {
+        out += "## What the results cover\n\n";
+        push_text(&mut out, text);
         out += &markdown_table(headers, rows);
         out += "\n";
     }
@@ -202,6 +211,11 @@ mod tests {
                 vec!["item".into(), "claim".into(), "verdict".into()],
                 vec![vec!["Fig. 6a".into(), "decays as exact".into(), "reproduced".into()]],
             )),
+            coverage: Some((
+                "The cases.".into(),
+                vec!["problem".into(), "cases".into()],
+                vec![vec!["`tg`".into(), "3".into()]],
+            )),
             parts: vec![Part {
                 title: "The CTVF paper".into(),
                 text: String::new(),
@@ -246,6 +260,7 @@ mod tests {
             "## Summary of the verdicts\n\n| item | claim | verdict |\n|---|---|---|\n| Fig. 6a |"
         ));
         let order = [
+            "## What the results cover\n\nThe cases.\n\n| problem | cases |\n|---|---|\n| `tg` | 3 |",
             "## The CTVF paper",
             "### 4.1 Taylor-Green",
             "#### Fig. 6a",

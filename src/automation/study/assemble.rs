@@ -5,7 +5,7 @@
 //! "beyond the paper" section per problem for what the paper does not show. A summary table
 //! of every claim and its verdict comes first.
 
-use super::{ProblemReport, ReportItem};
+use super::{ProblemReport, ReportItem, Verdict};
 use crate::automation::papers;
 use crate::automation::registry::Problem;
 use crate::automation::report::{Manuscript, Part, Section};
@@ -17,6 +17,9 @@ pub struct Header {
     pub title: String,
     /// The paragraphs before the summary.
     pub intro: String,
+    /// The coverage table of the cases (headers, rows), with the estimated cost of those
+    /// without a result.
+    pub cases: Option<(Vec<String>, Vec<Vec<String>>)>,
 }
 
 /// A problem's description for the manuscript, with where it comes from.
@@ -140,9 +143,26 @@ pub fn manuscript(header: Header, reports: &[(&Problem, &ProblemReport)]) -> Man
             sections,
         });
     }
+    let coverage = header.cases.map(|(h, rows)| {
+        let count = |v: Verdict| {
+            reports.iter().flat_map(|(_, r)| &r.verdicts).filter(|c| c.own.verdict == v).count()
+        };
+        let text = format!(
+            "Of the {} claims above, {} are reproduced, {} not reproduced and {} not run at their own preset. \
+             The cases of every problem, with a result or without one; the cost of those without is the sum of \
+             estimates measured from a short run of each case (`sphrepro reproduce --dry-run`, on one thread; \
+             they run low where a step grows dearer during a run).",
+            reports.iter().map(|(_, r)| r.verdicts.len()).sum::<usize>(),
+            count(Verdict::Reproduced),
+            count(Verdict::NotReproduced),
+            count(Verdict::NotRun)
+        );
+        (text, h, rows)
+    });
     Manuscript {
         title: header.title,
         intro: header.intro,
+        coverage,
         summary: (!summary.is_empty())
             .then(|| (vec!["figure or table".into(), "the paper's claim".into(), "verdict".into()], summary)),
         parts,
