@@ -398,8 +398,49 @@ fn post_process(dirs: &Dirs, problems: &[Problem], flags: &RunFlags) -> Result<(
         header.cases = Some(estimate::coverage(&read, problems));
         super::report::write_manuscript(&study::manuscript(header, &refs), &path)?;
         outln!("wrote {}", path.display());
+        let removed = sweep(&dirs.manuscript, &refs);
+        if !removed.is_empty() {
+            outln!(
+                "removed {} figure and table file(s) the manuscript no longer shows: {}",
+                removed.len(),
+                removed.join(", ")
+            );
+        }
     }
     Ok(())
+}
+
+/// Removes the files under `manuscript`'s `figures/` and `tables/` that no item of `reports`
+/// shows (every problem's, as `reproduce` draws them all): drawn from results that are gone,
+/// they would show what no result holds. Returns their names.
+fn sweep(manuscript: &Path, reports: &[(&Problem, &study::ProblemReport)]) -> Vec<String> {
+    let mut shown = std::collections::BTreeSet::new();
+    for (_, r) in reports {
+        for block in r.items.iter().flat_map(|it| &it.item.blocks) {
+            let (stem, kinds): (&str, [&str; 2]) = match block {
+                super::report::Block::Image { path, .. } => (path.trim_end_matches(".png"), ["png", "svg"]),
+                super::report::Block::Table { md_path, .. } => {
+                    (md_path.trim_end_matches(".md"), ["md", "csv"])
+                }
+                _ => continue,
+            };
+            shown.extend(kinds.map(|k| manuscript.join(format!("{stem}.{k}"))));
+        }
+    }
+    let mut removed = Vec::new();
+    for sub in ["figures", "tables"] {
+        let Ok(rd) = std::fs::read_dir(manuscript.join(sub)) else { continue };
+        for f in rd.flatten().map(|e| e.path()) {
+            let ours = f
+                .extension()
+                .is_some_and(|x| ["png", "svg", "md", "csv"].contains(&x.to_str().unwrap_or("")));
+            if ours && !shown.contains(&f) && std::fs::remove_file(&f).is_ok() {
+                removed.push(format!("{sub}/{}", f.file_name().unwrap_or_default().to_string_lossy()));
+            }
+        }
+    }
+    removed.sort();
+    removed
 }
 
 /// The manuscript's title and opening paragraphs for `preset`.

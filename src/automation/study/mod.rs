@@ -280,7 +280,10 @@ pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Probl
                 }
             }
             Prepared::Drawn(d) => d.blocks,
-            Prepared::Missing(why) => vec![Block::Missing { caption, why }],
+            Prepared::Missing(why) => {
+                remove_stale(&[figures.join(format!("{}.png", f.id)), figures.join(format!("{}.svg", f.id))]);
+                vec![Block::Missing { caption, why }]
+            }
         };
         items.push(item(&f.id, &f.title, &f.info, blocks, &verdicts));
     }
@@ -294,6 +297,7 @@ pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Probl
                 }
             }
         } else {
+            remove_stale(&[tables.join(format!("{}.md", t.id)), tables.join(format!("{}.csv", t.id))]);
             vec![Block::Missing {
                 caption: t.info.caption.clone(),
                 why: format!("no case of the `{}` preset has a result", p.preset),
@@ -305,6 +309,14 @@ pub fn regenerate(p: &Problem, output: &Path, manuscript: &Path) -> Result<Probl
         return Err(errors.join("\n"));
     }
     Ok(ProblemReport { items, verdicts, drawn })
+}
+
+/// Removes the files of a figure or table the manuscript now says is not drawn: drawn from
+/// results that are gone (their inputs changed), they would show what no result holds.
+fn remove_stale(files: &[std::path::PathBuf]) {
+    for f in files {
+        let _ = std::fs::remove_file(f);
+    }
 }
 
 /// An item of the manuscript: its heading (the paper's number, or our title), the paper's
