@@ -151,7 +151,12 @@ pub fn describe(m: &Measured) -> String {
     } else {
         format!("{} CPU-h", hours(e.cpu_seconds))
     };
-    format!("{cpu}, {}{}", bytes(e.peak_rss_bytes), if e.exact { ", measured whole" } else { "" })
+    let whole = match (e.diverged_at, e.exact) {
+        (Some(t), _) => format!(", diverged at t = {t:.4} s in the short run"),
+        (None, true) => ", measured whole".to_string(),
+        _ => String::new(),
+    };
+    format!("{cpu}, {}{whole}", bytes(e.peak_rss_bytes))
 }
 
 /// CPU seconds as hours with the digits that matter.

@@ -7,7 +7,8 @@
 //! measured building and stepping plus the steps still to come times the CPU time a timed
 //! step took; the steps still to come are the simulated time left over the mean time step
 //! of the timed steps, which is what the scene's time-step rule gives there. Where the short
-//! run reaches the scene's end time, the estimate is that run's own cost (`exact`).
+//! run reaches the scene's end time or diverges (as a stability map's case past its limit
+//! does), the estimate is that run's own cost (`exact`).
 //!
 //! What it cannot see: a cost that grows during a run (IPST's iterations, few in a flow's
 //! first steps and at their cap in a developed one; a time step that shrinks as the flow
@@ -44,8 +45,13 @@ pub struct Estimate {
     pub dt: f64,
     /// Steps timed.
     pub timed_steps: u64,
-    /// Whether the short run reached the end time (the estimate is its measured cost).
+    /// Whether the short run reached the end time or diverged (the estimate is its measured
+    /// cost).
     pub exact: bool,
+    /// The simulated time at which the short run diverged, if it did: the whole run stops
+    /// there too (a stability map's case past its limit).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diverged_at: Option<f64>,
 }
 
 /// Seconds of CPU this process has used (0 where the OS does not tell).
@@ -53,12 +59,9 @@ fn cpu() -> f64 {
     process_cpu_seconds().unwrap_or(0.0)
 }
 
-/// Steps `run` until `more` says stop or it reaches `tf`; a divergence is an error naming
-/// its time.
-fn step_while(run: &mut dyn SceneRun, tf: f64, more: &mut dyn FnMut(u64) -> bool) -> Result<(), String> {
-    run.advance(tf, tf, &mut |_, s| more(s)).map(|_| ()).map_err(|d| {
-        format!("diverged in its first steps, at t = {:.6} (step {}): {}", d.time, d.step, d.reason)
-    })
+/// Steps `run` until `more` says stop or it reaches `tf`; returns the time of a divergence.
+fn step_while(run: &mut dyn SceneRun, tf: f64, more: &mut dyn FnMut(u64) -> bool) -> Option<f64> {
+    run.advance(tf, tf, &mut |_, s| more(s)).err().map(|d| d.time)
 }
 
 /// Builds `scene` with `sets` and predicts its whole run from a short one of about `budget`
@@ -72,13 +75,15 @@ pub fn estimate_scene(scene: &str, sets: &[String], budget: f64) -> Result<Estim
     let setup_seconds = cpu() - c0;
     let particles = run.particles();
     let warm_end = run.steps() + WARMUP;
-    step_while(run.as_mut(), tf, &mut |s| s < warm_end)?;
+    let mut diverged_at = step_while(run.as_mut(), tf, &mut |s| s < warm_end);
     let (n0, t0, c1) = (run.steps(), run.time(), cpu());
-    // (getrusage after each step costs about a microsecond: nothing beside a step.)
-    step_while(run.as_mut(), tf, &mut |s| s - n0 < MIN_TIMED || cpu() - c1 < budget)?;
+    if diverged_at.is_none() {
+        // (getrusage after each step costs about a microsecond: nothing beside a step.)
+        diverged_at = step_while(run.as_mut(), tf, &mut |s| s - n0 < MIN_TIMED || cpu() - c1 < budget);
+    }
     let (timed, t1, c2) = (run.steps() - n0, run.time(), cpu());
     let peak_rss_bytes = status_kb("VmHWM:") * 1024;
-    let exact = t1 >= tf * (1.0 - 1e-12) || timed == 0;
+    let exact = t1 >= tf * (1.0 - 1e-12) || timed == 0 || diverged_at.is_some();
     let seconds_per_step = if timed > 0 { (c2 - c1) / timed as f64 } else { 0.0 };
     let dt = if timed > 0 { (t1 - t0) / timed as f64 } else { 0.0 };
     let (steps, cpu_seconds) = if exact || dt <= 0.0 {
@@ -97,6 +102,7 @@ pub fn estimate_scene(scene: &str, sets: &[String], budget: f64) -> Result<Estim
         dt,
         timed_steps: timed,
         exact,
+        diverged_at,
     })
 }
 

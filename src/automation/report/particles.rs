@@ -307,8 +307,44 @@ impl Render for ScatterField {
                 )
                 .map_err(|e| e.to_string())?;
         }
-        colour_bar(&bar, lo, hi, &self.value_label)
+        let flag = (0..n).all(|i| !self.value[i].is_finite() || self.value[i] == 0.0 || self.value[i] == 1.0);
+        if flag && (lo, hi) == (0.0, 1.0) {
+            flag_key(&bar, &self.value_label)
+        } else {
+            colour_bar(&bar, lo, hi, &self.value_label)
+        }
     }
+}
+
+/// The key of a field that is a flag (every value 0 or 1): two swatches, the colours the
+/// dots take, labelled 0 and 1 (a continuous bar would offer values none takes).
+fn flag_key<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str) -> Result<(), String> {
+    let mut bar = ChartBuilder::on(area)
+        .margin(MARGIN)
+        .margin_right(BAR_RIGHT_MARGIN)
+        .x_label_area_size(X_LABEL_AREA)
+        .right_y_label_area_size(BAR_PANEL - BAR_WIDTH - BAR_RIGHT_MARGIN - MARGIN)
+        .build_cartesian_2d(Axis::Linear(0.0, 1.0), Axis::Linear(0.0, 4.0))
+        .map_err(|e| e.to_string())?;
+    // Swatches at 0.5-1.5 (0) and 2.5-3.5 (1), their labels at the swatches' middles.
+    let swatches = [(0.0, 0.5), (1.0, 2.5)]
+        .map(|(v, y0)| Rectangle::new([(0.0, y0), (1.0, y0 + 1.0)], viridis(v).filled()));
+    bar.draw_series(swatches).map_err(|e| e.to_string())?;
+    let fmt = |v: &f64| match *v {
+        v if v == 1.0 => "0".to_string(),
+        v if v == 3.0 => "1".to_string(),
+        _ => String::new(),
+    };
+    bar.configure_mesh()
+        .disable_mesh()
+        .disable_x_axis()
+        .y_labels(5)
+        .y_label_formatter(&fmt)
+        .y_desc(label)
+        .label_style(canvas::text(canvas::TICK_SIZE))
+        .axis_desc_style(canvas::text(canvas::DESC_SIZE))
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 /// A vertical colour bar spanning `lo..hi` with ticks and `label`, aligned with the
