@@ -330,10 +330,14 @@ fn flag_key<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str) -> R
     let swatches = [(0.0, 0.5), (1.0, 2.5)]
         .map(|(v, y0)| Rectangle::new([(0.0, y0), (1.0, y0 + 1.0)], viridis(v).filled()));
     bar.draw_series(swatches).map_err(|e| e.to_string())?;
-    let fmt = |v: &f64| match *v {
-        v if v == 1.0 => "0".to_string(),
-        v if v == 3.0 => "1".to_string(),
-        _ => String::new(),
+    let fmt = |v: &f64| {
+        if *v == 1.0 {
+            "0".to_string()
+        } else if *v == 3.0 {
+            "1".to_string()
+        } else {
+            String::new()
+        }
     };
     bar.configure_mesh()
         .disable_mesh()
