@@ -149,10 +149,12 @@ fn dam_break_presets_figures_and_stability_sweep() {
             ("fig17b_dam_break_speed_t1.1", 1.1),
             ("fig17c_dam_break_speed_t2.0", 2.0),
         ] {
-            let registry::FigureKind::Particles { field, time, arrows: None } = &fig(id).kind else {
+            let registry::FigureKind::Particles { field, time, arrows: None, view } = &fig(id).kind else {
                 panic!()
             };
             assert_eq!((field.as_str(), *time), ("speed", Some(t)));
+            // The tank, as the paper frames it: the spray above it is counted, not drawn.
+            assert_eq!(*view, Some([-0.1, 4.1, -0.1, 4.1]));
             assert!(fig(id).select.pick(&p.cases).iter().all(|c| c.params.float("dx") == dx));
         }
         let registry::FigureKind::Particles { field, arrows, .. } = &fig("fig03_dam_break_normals").kind

@@ -110,6 +110,7 @@ impl Expand<'_> {
             ("x_range", f.x_range.is_some(), "profile"),
             ("time", f.time.is_some(), "particles"),
             ("arrows", f.arrows.is_some(), "particles"),
+            ("view", f.view.is_some(), "particles"),
             ("x_spacing", f.x_spacing, "trade"),
             ("exact", f.exact.is_some(), "timeseries"),
             ("exact_label", f.exact_label.is_some(), "timeseries"),
@@ -335,7 +336,22 @@ impl Expand<'_> {
                 ));
             }
         }
-        Ok(FigureKind::Particles { field, time: f.time, arrows: f.arrows.clone() })
+        let view = match f.view.as_deref() {
+            None => None,
+            Some(&[x0, x1, y0, y1])
+                if [x0, x1, y0, y1].iter().all(|v| v.is_finite()) && x0 < x1 && y0 < y1 =>
+            {
+                Some([x0, x1, y0, y1])
+            }
+            Some(v) => {
+                return Err(loc.err(
+                    span,
+                    &format!("{key}.view"),
+                    format!("`{v:?}` is not [x0, x1, y0, y1] with x0 < x1 and y0 < y1"),
+                ))
+            }
+        };
+        Ok(FigureKind::Particles { field, time: f.time, arrows: f.arrows.clone(), view })
     }
 
     /// The swept parameter `x` of a `trade` or `stability` figure: one the scene has.
@@ -702,11 +718,17 @@ mod tests {
         assert!(e.contains("not a time >= 0"), "{e}");
         let e = p(&kind("particles", "\nfield = \"p\"\narrows = \"<n>\"")).unwrap_err();
         assert!(e.contains("`figures.f1.arrows`"), "{e}");
+        assert!(p(&kind("particles", "\nfield = \"p\"\nview = [0.0, 1.0, 0.0, 2.0]")).is_ok());
+        for bad in ["[1.0, 0.0, 0.0, 1.0]", "[0.0, 1.0, 0.0]", "[0.0, 1.0, 2.0, 2.0]"] {
+            let e = p(&kind("particles", &format!("\nfield = \"p\"\nview = {bad}"))).unwrap_err();
+            assert!(e.contains("`figures.f1.view`") && e.contains("x0 < x1"), "{bad}: {e}");
+        }
         let e = p(&GOOD.replace("y = \"u_max\"", "y = \"vorticity\"")).unwrap_err();
         assert!(e.contains("`figures.f1.y`") && e.contains("no time-series column `vorticity`"), "{e}");
         for (extra, only) in [
             ("time = 0.01", "particles"),
             ("arrows = \"n\"", "particles"),
+            ("view = [0.0, 1.0, 0.0, 1.0]", "particles"),
             ("x_spacing = true", "trade"),
             ("x_label = \"u\"", "profile"),
         ] {

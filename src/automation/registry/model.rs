@@ -90,6 +90,9 @@ pub enum FigureKind {
         /// A 3-component point array (e.g. `normal`) drawn as segments about one particle
         /// spacing long at the particles where it is non-zero.
         arrows: Option<String>,
+        /// The region drawn, `[x0, x1, y0, y1]` (the paper's frame, e.g. the tank); `None`:
+        /// every particle. The particles outside it are counted in the figure's text.
+        view: Option<[f64; 4]>,
     },
     /// Error against cost (wall time and particle-steps) with the Pareto front, and the
     /// same as a table with the observed orders of convergence along `x`.

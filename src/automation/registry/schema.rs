@@ -121,6 +121,8 @@ pub(super) struct FigureFile {
     #[serde(default)]
     pub(super) arrows: Option<String>,
     #[serde(default)]
+    pub(super) view: Option<Vec<f64>>,
+    #[serde(default)]
     pub(super) x_spacing: bool,
     #[serde(default)]
     pub(super) above_max: Option<String>,

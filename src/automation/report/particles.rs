@@ -271,6 +271,7 @@ impl Render for ScatterField {
         let pw = (w - BAR_PANEL).saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1) as f64;
         let ph = h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1) as f64;
         let (x, y) = self.axes(pw, ph);
+        let (x_range, y_range) = (x.range(), y.range());
         let (lo, hi) = self.value_range();
         // Data units per pixel (the larger of the two axes' when they differ).
         let per_px = {
@@ -292,7 +293,9 @@ impl Render for ScatterField {
                     .map_err(|e| e.to_string())?;
             }
         }
-        let dots = (0..n).filter(|&i| self.x[i].is_finite() && self.y[i].is_finite()).map(|i| {
+        // Particles outside the axes (a figure's view) are left out, not piled on its edge.
+        let (xr, yr) = (x_range.clone(), y_range.clone());
+        let dots = (0..n).filter(|&i| xr.contains(&self.x[i]) && yr.contains(&self.y[i])).map(|i| {
             let c = viridis((self.value[i] - lo) / (hi - lo));
             Circle::new((self.x[i], self.y[i]), r, c.filled())
         });

@@ -438,7 +438,7 @@ fn prepare(
             }
             lines(f.x_label.clone().unwrap_or_else(|| x.clone()), y, series)
         }
-        FigureKind::Particles { field, time, arrows } => {
+        FigureKind::Particles { field, time, arrows, view } => {
             let Some(r) = rs.iter().find(|r| r.summary.is_some()) else {
                 return Ok(Prepared::Missing("no result".into()));
             };
@@ -466,8 +466,25 @@ fn prepare(
                 f if f.contains("surface") => String::new(),
                 f => format!(" `{f}` from {} to {}.", fmt_value(lo), fmt_value(hi)),
             };
+            let outside = match view {
+                Some([x0, x1, y0, y1]) => {
+                    let out: Vec<usize> = (0..s.x.len().min(s.y.len()))
+                        .filter(|&i| !(*x0..=*x1).contains(&s.x[i]) || !(*y0..=*y1).contains(&s.y[i]))
+                        .collect();
+                    let top = out.iter().map(|&i| s.y[i]).fold(f64::NEG_INFINITY, f64::max);
+                    match out.len() {
+                        0 => String::new(),
+                        n => format!(
+                            " {n} of its {} particles lie outside the frame drawn (x from {x0} to {x1} m, y from {y0} to {y1} m), the highest at y = {} m.",
+                            s.x.len(),
+                            fmt_value(top)
+                        ),
+                    }
+                }
+                None => String::new(),
+            };
             let ours = format!(
-                "Drawn: {who}, at t = {} s{asked}.{range} {}",
+                "Drawn: {who}, at t = {} s{asked}.{range}{outside} {}",
                 time_text(t, 3),
                 numbers(f, std::slice::from_ref(r))
             );
@@ -481,7 +498,7 @@ fn prepare(
                 y_label: "y (m)".into(),
                 walls: s.walls,
                 structures: s.structures,
-                extent: None,
+                extent: *view,
                 range: None,
                 aspect_equal: true,
                 arrows: s.arrows.map(|(u, v)| report::Arrows { u, v, length: None }),
@@ -535,9 +552,14 @@ fn share_axes(p: &Problem, prepared: &mut [Prepared]) {
                     }
                 }
                 Prepared::Particles(fig, ..) => {
-                    extend(&mut ext, &fig.x, &fig.y, false);
-                    for (wx, wy) in fig.walls.iter().chain(fig.structures.iter()) {
-                        extend(&mut ext, wx, wy, false);
+                    // A panel's view (its paper's frame) is its extent; else its particles'.
+                    if let Some([x0, x1, y0, y1]) = fig.extent {
+                        extend(&mut ext, &[x0, x1], &[y0, y1], false);
+                    } else {
+                        extend(&mut ext, &fig.x, &fig.y, false);
+                        for (wx, wy) in fig.walls.iter().chain(fig.structures.iter()) {
+                            extend(&mut ext, wx, wy, false);
+                        }
                     }
                     for v in fig.value.iter().filter(|v| v.is_finite()) {
                         range = (range.0.min(*v), range.1.max(*v));
@@ -1012,7 +1034,8 @@ field = "2*free_surface+near_surface"
             FigureKind::Particles {
                 field: "pressure".into(),
                 time: Some(0.6),
-                arrows: Some("normal".into())
+                arrows: Some("normal".into()),
+                view: None
             }
         );
         let output = root.join("output");
