@@ -67,6 +67,16 @@ impl Axis {
         }
     }
 
+    /// The axis with its upper end moved out by `fraction` of its span (of its decades on a
+    /// log axis): room for the labels written to the right of the points near it.
+    pub(crate) fn widened_right(self, fraction: f64) -> Axis {
+        match self {
+            Axis::Linear(lo, hi) => Axis::Linear(lo, hi + (hi - lo) * fraction),
+            Axis::Log(lo, hi) => Axis::Log(lo, hi * (hi / lo).powf(fraction)),
+            c => c,
+        }
+    }
+
     /// Whether `v` can be drawn on this axis (finite, and positive on a log axis).
     pub(crate) fn accepts(&self, v: f64) -> bool {
         v.is_finite() && !(matches!(self, Axis::Log(..)) && v <= 0.0)

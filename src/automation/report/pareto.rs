@@ -29,6 +29,9 @@ pub struct ParetoFigure {
 
 /// Indices of the non-dominated points when minimising both coordinates, sorted by x
 /// (then y). A point is dominated if another is no worse in both coordinates and better
+/// The share of the horizontal axis added on the right for the points' labels.
+const LABEL_ROOM: f64 = 0.12;
+
 /// in one; points with a NaN coordinate are never on the front; exact duplicates both are.
 pub fn pareto_front(points: &[(f64, f64)]) -> Vec<usize> {
     let dominates = |a: (f64, f64), b: (f64, f64)| a.0 <= b.0 && a.1 <= b.1 && (a.0 < b.0 || a.1 < b.1);
@@ -57,7 +60,8 @@ impl Render for ParetoFigure {
     }
 
     fn render<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<(), String> {
-        let x = Axis::fit(self.points.iter().map(|p| p.2), self.log_x);
+        // Each point's resolution is written to its right: room for the rightmost one's.
+        let x = Axis::fit(self.points.iter().map(|p| p.2), self.log_x).widened_right(LABEL_ROOM);
         let y = Axis::fit(self.points.iter().map(|p| p.3), self.log_y);
         let shown: Vec<&(String, String, f64, f64)> =
             self.points.iter().filter(|p| x.accepts(p.2) && y.accepts(p.3)).collect();

@@ -79,7 +79,8 @@ pub(super) fn trade(
             .collect();
         report::pareto_figure(
             &report::ParetoFigure {
-                title: format!("{}: {m} against {what}", f.title),
+                // The axes name the metric and the cost; the title says which cost.
+                title: format!("{}: {}", f.title, what.split(" (").next().unwrap_or(what)),
                 x_label: what.into(),
                 y_label: f.y_label.clone().unwrap_or_else(|| format!("{m} (-)")),
                 points,
