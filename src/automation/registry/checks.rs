@@ -114,6 +114,7 @@ impl Expand<'_> {
             ("x_spacing", f.x_spacing, "trade"),
             ("exact", f.exact.is_some(), "timeseries"),
             ("exact_label", f.exact_label.is_some(), "timeseries"),
+            ("metric_over", f.metric_over.is_some(), "timeseries"),
             ("above_max", f.above_max.is_some(), "stability"),
         ] {
             if set && f.kind != only {
@@ -292,7 +293,23 @@ impl Expand<'_> {
             return Err(self.loc.err(span, &format!("{key}.exact_label"), "names no `exact` column"));
         }
         let exact_label = f.exact_label.clone().unwrap_or_else(|| "exact".into());
-        Ok(FigureKind::Timeseries { y, exact: f.exact.clone(), exact_label })
+        if let Some(w) = f.metric_over {
+            if !(w > 0.0 && w <= 1.0) {
+                return Err(self.loc.err(
+                    span,
+                    &format!("{key}.metric_over"),
+                    format!("`{w}` is not a fraction of the run in (0, 1]"),
+                ));
+            }
+            if f.metric.is_none() {
+                return Err(self.loc.err(
+                    span,
+                    &format!("{key}.metric_over"),
+                    "the figure names no `metric` to draw",
+                ));
+            }
+        }
+        Ok(FigureKind::Timeseries { y, exact: f.exact.clone(), exact_label, metric_over: f.metric_over })
     }
 
     /// A `particles` figure of point array `field`: its `time` is one every selected case

@@ -78,6 +78,11 @@ pub enum FigureKind {
         /// Its legend entry: what the solution is ("exact" unless the problem names it, as
         /// where the reference is exact only for another set-up).
         exact_label: String,
+        /// Where the figure's `metric` is a mean of the curve over the last part of each
+        /// run, that part as a fraction of the run (`metric_over = 0.5`: its second half):
+        /// the metric is drawn as a segment over it, so that the value tested is seen beside
+        /// an oscillating curve.
+        metric_over: Option<f64>,
     },
     /// The particles of one case's snapshot (the last one, or the one nearest `time`),
     /// coloured by a point array, with an optional vector array drawn as short segments.

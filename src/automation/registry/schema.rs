@@ -105,6 +105,8 @@ pub(super) struct FigureFile {
     #[serde(default)]
     pub(super) exact_label: Option<String>,
     #[serde(default)]
+    pub(super) metric_over: Option<f64>,
+    #[serde(default)]
     pub(super) y_label: Option<String>,
     #[serde(default)]
     pub(super) log_y: bool,

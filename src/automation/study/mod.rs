@@ -387,7 +387,7 @@ fn prepare(
         Prepared::Lines(fig, numbers(f, &rs))
     };
     Ok(match &f.kind {
-        FigureKind::Timeseries { y, exact, exact_label } => {
+        FigureKind::Timeseries { y, exact, exact_label, metric_over } => {
             let mut series = Vec::new();
             for r in rs.iter().filter(|r| r.summary.is_some() && r.dir().join("timeseries.csv").exists()) {
                 let (t, v) = timeseries(p, r, y)?;
@@ -402,7 +402,24 @@ fn prepare(
                         });
                     }
                 }
+                let (t0, t1) = (t.first().copied(), t.last().copied());
                 series.push(Series { label: group(r.case, &f.label), x: t, y: v, style: SeriesStyle::Line });
+                // The value tested, a mean over the run's last part, drawn over that part.
+                if let (Some(w), Some(m), Some(t0), Some(t1)) = (metric_over, &f.metric, t0, t1) {
+                    if let Some(value) = r.metric(m) {
+                        let from = t1 - w * (t1 - t0);
+                        series.push(Series {
+                            label: format!(
+                                "{}: mean over the last {:.0} %",
+                                group(r.case, &f.label),
+                                w * 100.0
+                            ),
+                            x: vec![from, t1],
+                            y: vec![value, value],
+                            style: SeriesStyle::LinePoints,
+                        });
+                    }
+                }
             }
             lines("t (s)".into(), y, series)
         }
