@@ -322,17 +322,9 @@ impl Render for ScatterField {
 /// The key of a field that is a flag (every value 0 or 1): two swatches, the colours the
 /// dots take, labelled 0 and 1 (a continuous bar would offer values none takes).
 fn flag_key<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str) -> Result<(), String> {
-    let mut bar = ChartBuilder::on(area)
-        .margin(MARGIN)
-        .margin_right(BAR_RIGHT_MARGIN)
-        .x_label_area_size(X_LABEL_AREA)
-        .right_y_label_area_size(BAR_PANEL - BAR_WIDTH - BAR_RIGHT_MARGIN - MARGIN)
-        .build_cartesian_2d(Axis::Linear(0.0, 1.0), Axis::Linear(0.0, 4.0))
-        .map_err(|e| e.to_string())?;
     // Swatches at 0.5-1.5 (0) and 2.5-3.5 (1), their labels at the swatches' middles.
     let swatches = [(0.0, 0.5), (1.0, 2.5)]
         .map(|(v, y0)| Rectangle::new([(0.0, y0), (1.0, y0 + 1.0)], viridis(v).filled()));
-    bar.draw_series(swatches).map_err(|e| e.to_string())?;
     let fmt = |v: &f64| {
         if *v == 1.0 {
             "0".to_string()
@@ -342,16 +334,7 @@ fn flag_key<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, label: &str) -> R
             String::new()
         }
     };
-    bar.configure_mesh()
-        .disable_mesh()
-        .disable_x_axis()
-        .y_labels(5)
-        .y_label_formatter(&fmt)
-        .y_desc(label)
-        .label_style(canvas::text(canvas::TICK_SIZE))
-        .axis_desc_style(canvas::text(canvas::DESC_SIZE))
-        .draw()
-        .map_err(|e| e.to_string())
+    key_panel(area, (0.0, 4.0), swatches, 5, &fmt, label)
 }
 
 /// A vertical colour bar spanning `lo..hi` with ticks and `label`, aligned with the
@@ -362,6 +345,29 @@ fn colour_bar<DB: DrawingBackend>(
     hi: f64,
     label: &str,
 ) -> Result<(), String> {
+    let step = (hi - lo) / BAR_SAMPLES as f64;
+    let cells = (0..BAR_SAMPLES).map(|k| {
+        let v = lo + step * k as f64;
+        let c = viridis((k as f64 + 0.5) / BAR_SAMPLES as f64);
+        Rectangle::new([(0.0, v), (1.0, v + step)], c.filled())
+    });
+    // As the chart axes label their ticks: one computed as lo + k * step that misses zero
+    // by rounding reads 0, not -5.551e-17.
+    let axis = Axis::Linear(lo, hi);
+    key_panel(area, (lo, hi), cells, 8, &|v: &f64| axis.format(*v), label)
+}
+
+/// The panel beside a particle chart that keys its colours: `cells` drawn over a vertical
+/// axis `lo..hi` aligned with the chart's plotting area, `labels` ticks written by `fmt`,
+/// and `label` along it.
+fn key_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    (lo, hi): (f64, f64),
+    cells: impl IntoIterator<Item = Rectangle<(f64, f64)>>,
+    labels: usize,
+    fmt: &dyn Fn(&f64) -> String,
+    label: &str,
+) -> Result<(), String> {
     let mut bar = ChartBuilder::on(area)
         .margin(MARGIN)
         .margin_right(BAR_RIGHT_MARGIN)
@@ -369,22 +375,12 @@ fn colour_bar<DB: DrawingBackend>(
         .right_y_label_area_size(BAR_PANEL - BAR_WIDTH - BAR_RIGHT_MARGIN - MARGIN)
         .build_cartesian_2d(Axis::Linear(0.0, 1.0), Axis::Linear(lo, hi))
         .map_err(|e| e.to_string())?;
-    let step = (hi - lo) / BAR_SAMPLES as f64;
-    let cells = (0..BAR_SAMPLES).map(|k| {
-        let v = lo + step * k as f64;
-        let c = viridis((k as f64 + 0.5) / BAR_SAMPLES as f64);
-        Rectangle::new([(0.0, v), (1.0, v + step)], c.filled())
-    });
     bar.draw_series(cells).map_err(|e| e.to_string())?;
-    // As the chart axes label their ticks: one computed as lo + k * step that misses zero
-    // by rounding reads 0, not -5.551e-17.
-    let axis = Axis::Linear(lo, hi);
-    let fmt = |v: &f64| axis.format(*v);
     bar.configure_mesh()
         .disable_mesh()
         .disable_x_axis()
-        .y_labels(8)
-        .y_label_formatter(&fmt)
+        .y_labels(labels)
+        .y_label_formatter(fmt)
         .y_desc(label)
         .label_style(canvas::text(canvas::TICK_SIZE))
         .axis_desc_style(canvas::text(canvas::DESC_SIZE))
